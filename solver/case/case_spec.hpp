@@ -1,0 +1,135 @@
+// The typed, validated form of a case file (DESIGN.md section 5).
+//
+// A case file is JSON; `case::load_case` parses it, applies the chosen fidelity level and
+// the `--set` overrides, validates every value, and returns a CaseSpec. Nothing downstream
+// reads JSON: model code sees only these types. Units: every length is in units of the
+// reference length L (D for a cylinder, a for a capsule), every velocity in units of the
+// reference velocity U (U∞, or k·a for shear flow), time in L/U (t·U∞/D, or k·t).
+#pragma once
+
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace caplab::cases {
+
+/// Imposed (unperturbed) flow: initial condition and far-field / wall velocity.
+struct FlowSpec {
+  enum class Type {
+    rest,         ///< u = 0
+    uniform,      ///< u = U · direction (flow past a body)
+    shear,        ///< u_x = k (x_g − centre_g), g = y in 2D, z in 3D (thesis section 4 conventions)
+    body_force,   ///< u = 0 initially, driven by a constant body force along x (Poiseuille)
+    taylor_green  ///< decaying Taylor–Green vortex (verification)
+  };
+  Type type = Type::rest;
+  std::vector<double> direction;  ///< uniform: unit vector (default +x)
+  double body_force = 0.0;        ///< body_force: force density along x, in ρU²/L
+};
+
+/// What happens on the two faces normal to one axis.
+enum class BoundaryType {
+  periodic,   ///< periodic along this axis
+  far_field,  ///< unperturbed flow imposed by Guo's non-equilibrium extrapolation
+  wall        ///< half-way bounce-back wall moving with the imposed flow's velocity there
+};
+
+struct RigidMotionSpec {
+  enum class Type { fixed };
+  Type type = Type::fixed;
+};
+
+struct ShapeSpec {
+  enum class Type { circle, sphere };
+  Type type = Type::circle;
+  std::vector<double> center;  ///< in L
+  double diameter = 1.0;       ///< in L
+};
+
+struct BodySpec {
+  std::string name;
+  ShapeSpec shape;
+  RigidMotionSpec motion;
+};
+
+struct PhysicsSpec {
+  int dimension = 2;
+  FlowSpec flow;
+  double reynolds = 1.0;             ///< with the convention of the flow type (see units)
+  std::vector<double> domain_size;   ///< in L, one per axis
+  std::vector<BoundaryType> boundaries;  ///< one per axis
+  std::vector<BodySpec> bodies;
+};
+
+struct GridSpec {
+  enum class Refinement { uniform, two_level };
+  Refinement refinement = Refinement::uniform;
+  double fine_spacing = 0.02;        ///< Δx of the finest block, in L (coarse = 2·fine)
+  std::vector<double> fine_min, fine_max;  ///< fine block extent in L (two_level only)
+};
+
+struct CollisionSpec {
+  enum class Operator { bgk, trt };
+  Operator op = Operator::bgk;
+  double magic = 0.25;  ///< TRT magic parameter Λ = (τ+ − ½)(τ− − ½)
+};
+
+struct IbSpec {
+  enum class Kernel { cosine4, roma3, linear2 };
+  Kernel kernel = Kernel::cosine4;
+  double marker_spacing = 0.79;  ///< Lagrangian marker spacing in fine-grid spacings
+  int forcing_iterations = 1;    ///< multi-direct-forcing iterations (1 = plain direct forcing)
+};
+
+enum class Precision { double_, single };
+
+struct NumericsSpec {
+  GridSpec grid;
+  CollisionSpec collision;
+  Precision precision = Precision::double_;
+  IbSpec ib;
+  double lattice_velocity = 0.1;  ///< U in lattice units (same on every block: acoustic scaling)
+  double end_time = 1.0;          ///< in L/U
+  int threads = 0;                ///< 0: OpenMP default
+};
+
+struct SeriesSpec {
+  double interval = 0.1;             ///< sampling interval of the time series, in L/U
+  std::vector<std::string> quantities;  ///< e.g. "drag", "lift", "kinetic_energy", "mass"
+};
+
+struct SnapshotSpec {
+  std::vector<double> times;          ///< in L/U
+  std::vector<std::string> fields;    ///< "vorticity", "velocity", "density"
+};
+
+struct OutputSpec {
+  SeriesSpec series;
+  SnapshotSpec snapshots;
+  double average_from = 0.0;  ///< start of the window for means, amplitudes and frequencies (L/U)
+};
+
+/// One scored metric (issue "catalogue scoring"); kept typed so scoring and reports share it.
+struct AcceptanceSpec {
+  std::string metric;         ///< a key of summary.json
+  std::string reference;      ///< path of a references/ dataset (with #key) or "value"
+  double reference_value = 0.0;
+  std::string comparison;     ///< "relative" | "absolute"
+  std::map<std::string, double> tolerance;  ///< per fidelity level
+  std::string justification;
+};
+
+struct CaseSpec {
+  std::string source_file;  ///< where it was loaded from (for messages)
+  std::string id, title, description;
+  std::string fidelity;     ///< the level that was applied
+  PhysicsSpec physics;
+  NumericsSpec numerics;
+  OutputSpec outputs;
+  std::vector<AcceptanceSpec> acceptance;
+  nlohmann::json resolved;  ///< the fully resolved JSON (fidelity and overrides applied)
+};
+
+}  // namespace caplab::cases

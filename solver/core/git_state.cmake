@@ -1,0 +1,20 @@
+# Writes git_state.hpp with the current sha and dirty flag; rewrites only on change.
+execute_process(COMMAND git rev-parse HEAD WORKING_DIRECTORY ${SRC}
+                OUTPUT_VARIABLE sha OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+execute_process(COMMAND git status --porcelain --untracked-files=no WORKING_DIRECTORY ${SRC}
+                OUTPUT_VARIABLE st OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+if(NOT sha)
+  set(sha "unknown")
+endif()
+if(st)
+  set(dirty "true")
+else()
+  set(dirty "false")
+endif()
+set(text "#pragma once\n#define CAPLAB_GIT_SHA \"${sha}\"\n#define CAPLAB_GIT_DIRTY ${dirty}\n")
+if(EXISTS ${OUT})
+  file(READ ${OUT} old)
+endif()
+if(NOT "${old}" STREQUAL "${text}")
+  file(WRITE ${OUT} "${text}")
+endif()
