@@ -1,0 +1,34 @@
+// Checks of a case that involve more than one value: lengths per dimension, grid spacing
+// against domain and fine block, block and body placement, output times against the end time,
+// tolerances against fidelity levels. They run on the typed CaseSpec after the schema pass
+// (case_schema.hpp), so types and single-value ranges are already known to be right.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "case/case_diagnostics.hpp"
+#include "case/case_spec.hpp"
+
+namespace caplab::cases {
+
+/// Most lattice nodes a case may ask for (all blocks together); more is surely a typo.
+inline constexpr double max_lattice_nodes = 2e9;
+/// Relative tolerance for "is a whole multiple of the spacing".
+inline constexpr double spacing_tolerance = 1e-9;
+/// Fine block faces keep this many coarse spacings from the domain faces.
+inline constexpr int fine_region_margin_coarse = 4;
+/// Bodies keep this many fine spacings from the fine block faces (IB kernel support).
+inline constexpr int body_margin_fine = 3;
+
+/// Checks that every array listed in `per_axis_pointers` has `dimension` entries.
+void check_axis_lengths(const nlohmann::json& doc, int dimension,
+                        const std::vector<std::string>& per_axis_pointers, const CaseDiagnostics& diag);
+
+/// Checks the cross-value rules listed above; throws core::InputError at the first violation.
+/// `levels` are the fidelity levels the case defines.
+void check_consistency(const CaseSpec& spec, const std::vector<std::string>& levels,
+                       const CaseDiagnostics& diag);
+
+}  // namespace caplab::cases

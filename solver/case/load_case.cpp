@@ -1,0 +1,292 @@
+// Case files -> validated CaseSpec (see load_case.hpp for the pipeline).
+#include "case/load_case.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <set>
+
+#include "case/case_consistency.hpp"
+#include "case/case_diagnostics.hpp"
+#include "case/case_enums.hpp"
+#include "case/case_schema.hpp"
+#include "core/error.hpp"
+
+namespace caplab::cases {
+namespace {
+
+using nlohmann::json;
+
+// ---- Reading. ----
+
+// Tracks where the parser is, to name the place of a repeated key (nlohmann keeps the last one
+// silently, which would hide a typo'd copy-paste).
+class DuplicateKeyGuard {
+ public:
+  explicit DuplicateKeyGuard(std::string file) : file_(std::move(file)) {}
+
+  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+        frames_.push_back({false, "", 0, {}});
+        break;
+      case json::parse_event_t::array_start:
+        frames_.push_back({true, "", 0, {}});
+        break;
+      case json::parse_event_t::key: {
+        Frame& top = frames_.back();
+        top.key = parsed.get<std::string>();
+        if (!top.seen.insert(top.key).second)
+          throw core::InputError(file_, pointer(), "the key \"" + top.key + "\" a second time in one object",
+                                 "each key at most once per object");
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        frames_.pop_back();
+        [[fallthrough]];
+      case json::parse_event_t::value:
+        if (!frames_.empty() && frames_.back().is_array) ++frames_.back().index;
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool is_array;
+    std::string key;
+    std::size_t index;
+    std::set<std::string> seen;
+  };
+  std::string pointer() const {
+    std::string p;
+    for (const auto& f : frames_) p = f.is_array ? child_pointer(p, f.index) : child_pointer(p, f.key);
+    return p;
+  }
+  std::string file_;
+  std::vector<Frame> frames_;
+};
+
+// nlohmann prefixes its messages with "[json.exception.parse_error.101] "; users need the rest.
+std::string without_exception_id(const std::string& what) {
+  const std::size_t close = what.find("] ");
+  return what.rfind("[json.exception.", 0) == 0 && close != std::string::npos ? what.substr(close + 2) : what;
+}
+
+// ---- Fidelity levels and overrides. ----
+
+// The fidelity levels of `doc`, after checking the "fidelity" object itself.
+std::vector<std::string> checked_levels(const json& doc, const CaseDiagnostics& diag) {
+  if (!doc.is_object()) diag.fail("", doc, case_schema().expected());
+  const SchemaMember& member = *case_schema().member("fidelity");
+  if (!doc.contains("fidelity"))
+    diag.fail_text("/fidelity", "nothing (required key \"fidelity\" is missing)", member.node.expected());
+  std::vector<std::string> unused;
+  check_against(member.node, doc.at("fidelity"), "/fidelity", diag, unused);
+  std::vector<std::string> levels;
+  for (const auto& item : doc.at("fidelity").items()) levels.push_back(item.key());
+  return levels;
+}
+
+// Applies every entry of fidelity level `level` to `target`; records origins when asked.
+void apply_level(json& target, const json& doc, const std::string& level, CaseDiagnostics& diag,
+                 bool record) {
+  const std::string site = child_pointer("/fidelity", level);
+  for (const auto& item : doc.at("fidelity").at(level).items()) {
+    const std::string label = "\"" + item.key() + "\": " + describe(item.value());
+    const std::string written =
+        apply_override(target, item.key(), item.value(), label, child_pointer(site, item.key()), diag);
+    if (record) diag.note_origin(written, "fidelity level \"" + level + "\"");
+  }
+}
+
+// Applies one "--set path=value" override; the value is JSON if it parses, else a string.
+void apply_set(json& target, const std::string& text, CaseDiagnostics& diag) {
+  const std::string label = "--set " + text;
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    diag.fail_text("", label, "an override of the form path=value, e.g. physics.reynolds=200");
+  std::string path = text.substr(0, eq);
+  path.erase(path.find_last_not_of(" \t") + 1);
+  path.erase(0, path.find_first_not_of(" \t"));
+  const std::string raw = text.substr(eq + 1);
+  json value = json::parse(raw, nullptr, /*allow_exceptions=*/false);
+  if (value.is_discarded()) value = raw;
+  const std::string written = apply_override(target, path, std::move(value), label, "", diag);
+  diag.note_origin(written, label);
+}
+
+// ---- Conversion to CaseSpec (the document has passed the schema checks). ----
+
+CaseSpec to_spec(const json& doc) {
+  CaseSpec spec;
+  spec.id = doc.at("id").get<std::string>();
+  spec.title = doc.at("title").get<std::string>();
+  spec.description = doc.at("description").get<std::string>();
+
+  const json& p = doc.at("physics");
+  PhysicsSpec& physics = spec.physics;
+  physics.dimension = p.at("dimension").get<int>();
+  const json& flow = p.at("flow");
+  physics.flow.type = enum_value(flow_type_names, flow.at("type").get<std::string>());
+  physics.flow.direction = flow.value("direction", physics.flow.direction);
+  physics.flow.body_force = flow.value("body_force", physics.flow.body_force);
+  physics.reynolds = p.at("reynolds").get<double>();
+  physics.domain_size = p.at("domain").at("size").get<std::vector<double>>();
+  for (const auto& b : p.at("domain").at("boundaries")) {
+    physics.boundaries.push_back(enum_value(boundary_names, b.get<std::string>()));
+  }
+  for (const auto& b : p.at("bodies")) {
+    BodySpec body;
+    body.name = b.at("name").get<std::string>();
+    body.shape.type = enum_value(shape_type_names, b.at("shape").at("type").get<std::string>());
+    body.shape.center = b.at("shape").at("center").get<std::vector<double>>();
+    body.shape.diameter = b.at("shape").at("diameter").get<double>();
+    body.motion.type = enum_value(motion_type_names, b.at("motion").at("type").get<std::string>());
+    physics.bodies.push_back(std::move(body));
+  }
+
+  // Optional keys fall back to the defaults written in case_spec.hpp.
+  const json& n = doc.at("numerics");
+  NumericsSpec& numerics = spec.numerics;
+  const json& grid = n.at("grid");
+  numerics.grid.refinement = enum_value(refinement_names, grid.at("refinement").get<std::string>());
+  numerics.grid.fine_spacing = grid.at("fine_spacing").get<double>();
+  if (grid.contains("fine_region")) {
+    numerics.grid.fine_min = grid.at("fine_region").at("min").get<std::vector<double>>();
+    numerics.grid.fine_max = grid.at("fine_region").at("max").get<std::vector<double>>();
+  }
+  const json& collision = n.at("collision");
+  numerics.collision.op = enum_value(collision_names, collision.at("operator").get<std::string>());
+  numerics.collision.magic = collision.value("magic", numerics.collision.magic);
+  numerics.precision = enum_value(precision_names, n.at("precision").get<std::string>());
+  const json ib = n.value("ib", json::object());
+  if (ib.contains("kernel"))
+    numerics.ib.kernel = enum_value(kernel_names, ib.at("kernel").get<std::string>());
+  numerics.ib.marker_spacing = ib.value("marker_spacing", numerics.ib.marker_spacing);
+  numerics.ib.forcing_iterations = ib.value("forcing_iterations", numerics.ib.forcing_iterations);
+  numerics.lattice_velocity = n.at("lattice_velocity").get<double>();
+  numerics.end_time = n.at("end_time").get<double>();
+  numerics.threads = n.value("threads", numerics.threads);
+
+  const json& o = doc.at("outputs");
+  spec.outputs.series.interval = o.at("series").at("interval").get<double>();
+  spec.outputs.series.quantities = o.at("series").at("quantities").get<std::vector<std::string>>();
+  if (o.contains("snapshots")) {
+    spec.outputs.snapshots.times = o.at("snapshots").at("times").get<std::vector<double>>();
+    spec.outputs.snapshots.fields = o.at("snapshots").at("fields").get<std::vector<std::string>>();
+  }
+  spec.outputs.average_from = o.value("average_from", spec.outputs.average_from);
+
+  for (const auto& a : doc.value("acceptance", json::array())) {
+    AcceptanceSpec entry;
+    entry.metric = a.at("metric").get<std::string>();
+    entry.reference = a.at("reference").get<std::string>();
+    entry.reference_value = a.at("reference_value").get<double>();
+    entry.comparison = a.at("comparison").get<std::string>();
+    entry.tolerance = a.at("tolerance").get<std::map<std::string, double>>();
+    entry.justification = a.at("justification").get<std::string>();
+    spec.acceptance.push_back(std::move(entry));
+  }
+  return spec;
+}
+
+// Normalises the flow direction and writes every default that was used back into `resolved`,
+// so that the case.json of a run states every value it ran with (DESIGN.md section 6).
+void complete(CaseSpec& spec, json& resolved) {
+  FlowSpec& flow = spec.physics.flow;
+  if (flow.type == FlowSpec::Type::uniform) {
+    if (flow.direction.empty()) {
+      flow.direction.assign(static_cast<std::size_t>(spec.physics.dimension), 0.0);
+      flow.direction[0] = 1.0;
+    }
+    double norm2 = 0;
+    for (double c : flow.direction) norm2 += c * c;
+    for (double& c : flow.direction) c /= std::sqrt(norm2);
+    resolved["physics"]["flow"]["direction"] = flow.direction;
+  }
+  const NumericsSpec& numerics = spec.numerics;
+  if (numerics.collision.op == CollisionSpec::Operator::trt)
+    resolved["numerics"]["collision"]["magic"] = numerics.collision.magic;
+  resolved["numerics"]["ib"] = {{"kernel", enum_name(kernel_names, numerics.ib.kernel)},
+                                {"marker_spacing", numerics.ib.marker_spacing},
+                                {"forcing_iterations", numerics.ib.forcing_iterations}};
+  resolved["numerics"]["threads"] = numerics.threads;
+  resolved["outputs"]["snapshots"] = {{"times", spec.outputs.snapshots.times},
+                                      {"fields", spec.outputs.snapshots.fields}};
+  resolved["outputs"]["average_from"] = spec.outputs.average_from;
+  if (!resolved.contains("acceptance")) resolved["acceptance"] = json::array();
+  spec.resolved = std::move(resolved);
+}
+
+}  // namespace
+
+json read_case_json(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw core::InputError(
+        fmt::format("{}: cannot read the case file: {}", file.string(),
+                    std::filesystem::exists(file, ec) ? "not a regular file" : "no such file"));
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw core::InputError(fmt::format("{}: cannot open the case file for reading", file.string()));
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  try {
+    return json::parse(text, DuplicateKeyGuard(file.string()));
+  } catch (const json::exception& e) {  // parse_error carries line and column in its message
+    throw core::InputError(
+        fmt::format("{}: malformed JSON: {}", file.string(), without_exception_id(e.what())));
+  }
+}
+
+CaseSpec parse_case(const json& doc, const std::string& source_name, const std::string& fidelity,
+                    const std::vector<std::string>& overrides) {
+  CaseDiagnostics diag(source_name);
+  const std::vector<std::string> levels = checked_levels(doc, diag);
+  if (std::find(levels.begin(), levels.end(), fidelity) == levels.end())
+    diag.fail_text(
+        "/fidelity", "fidelity level \"" + fidelity + "\"",
+        "a level this case defines: " + (levels.empty() ? std::string("(none)") : quoted_list(levels)) +
+            did_you_mean(fidelity, levels));
+
+  // Every level's paths must exist, even those not applied now, so that a typo in "thesis"
+  // is found by a "quick" run.
+  json resolved = doc;
+  for (const auto& level : levels) {
+    if (level == fidelity) continue;
+    json scratch = doc;
+    apply_level(scratch, doc, level, diag, false);
+  }
+  apply_level(resolved, doc, fidelity, diag, true);
+  for (const auto& text : overrides) apply_set(resolved, text, diag);
+
+  std::vector<std::string> per_axis;
+  check_against(case_schema(), resolved, "", diag, per_axis);
+  check_conditional_keys(resolved, diag);
+  check_axis_lengths(resolved, resolved.at("physics").at("dimension").get<int>(), per_axis, diag);
+
+  CaseSpec spec = to_spec(resolved);
+  spec.source_file = source_name;
+  spec.fidelity = fidelity;
+  check_consistency(spec, levels, diag);
+  complete(spec, resolved);
+  return spec;
+}
+
+CaseSpec load_case(const std::filesystem::path& file, const std::string& fidelity,
+                   const std::vector<std::string>& overrides) {
+  return parse_case(read_case_json(file), file.string(), fidelity, overrides);
+}
+
+std::vector<std::string> fidelity_levels(const json& doc, const std::string& source_name) {
+  return checked_levels(doc, CaseDiagnostics(source_name));
+}
+
+std::vector<std::string> fidelity_levels(const std::filesystem::path& file) {
+  return fidelity_levels(read_case_json(file), file.string());
+}
+
+}  // namespace caplab::cases

@@ -1,0 +1,105 @@
+// The fused collide-and-push kernel of one block (thesis eq. 2.1 and 2.23).
+//
+// One pass over the interior: read the Q shifted populations of a node (pre-collision,
+// time t), compute ρ and u (with half the force when forced), the equilibrium, collide,
+// and push post-collision value i to the neighbour along c_i in the other buffer. Pushes
+// that leave the interior land in the ghost layer, where the boundary stages pick them up;
+// populations entering the interior from outside are written by those stages.
+// The force term is compiled away for unforced blocks (Forced = false).
+// Rows (x lines) are distributed over OpenMP threads; the x loop is straight-line code.
+#pragma once
+
+#include <omp.h>
+
+#include "collision/equilibrium.hpp"
+#include "collision/operators.hpp"
+#include "field/grid.hpp"
+#include "field/populations.hpp"
+
+namespace caplab::collision {
+
+/// Visits all interior rows (x lines) of a grid in parallel: f(row_base, n_x).
+template <int D, class F>
+void parallel_rows(const field::Grid<D>& g, F&& f) {
+  const int nx = g.n()[0];
+  const int ny = g.n()[1];
+  const int nz = D == 3 ? g.n()[D - 1] : 1;
+  const long rows = static_cast<long>(ny) * nz;
+#pragma omp parallel for schedule(static)
+  for (long r = 0; r < rows; ++r) {
+    Index<D> ijk{};
+    ijk[1] = static_cast<int>(r % ny);
+    if constexpr (D == 3) ijk[2] = static_cast<int>(r / ny);
+    f(g.index(ijk), nx);
+  }
+}
+
+/// One time step of the fluid on a block: collide and stream into `next()`, no swap.
+/// `force` (lattice units, per node) must be non-null exactly when Forced is true.
+template <bool Forced, class L, class T, class Op>
+void stream_collide(field::Populations<L, T>& pop, const Op& op,
+                    const field::VectorField<L::d, double>* force = nullptr) {
+  constexpr int Q = L::q, D = L::d;
+  const auto& g = pop.grid();
+  const std::ptrdiff_t N = g.size();
+  std::array<std::ptrdiff_t, Q> off;
+  for (int i = 0; i < Q; ++i) off[i] = g.offset(L::c[i]);
+  const T* __restrict src = pop.current();
+  T* __restrict dst = pop.next();
+  std::array<const double*, D> fp{};
+  if constexpr (Forced)
+    for (int a = 0; a < D; ++a) fp[a] = force->comp[a].data();
+
+  parallel_rows<D>(g, [&](std::ptrdiff_t base, int nx) {
+#pragma omp simd
+    for (int x = 0; x < nx; ++x) {
+      const std::ptrdiff_t n = base + x;
+      T f[Q], feq[Q], out[Q];
+#pragma GCC unroll 19
+      for (int i = 0; i < Q; ++i) f[i] = src[i * N + n];
+      if constexpr (Forced) {
+        T F[D], s[Q];
+        for (int a = 0; a < D; ++a) F[a] = T(fp[a][n]);
+        const auto m = moments<L, T>(f, F);
+        equilibrium<L, T>(m.rho, m.u, feq);
+        guo_source<L, T>(m.u, F, s);
+        op.template collide<L, T>(f, feq, s, out);
+      } else {
+        const auto m = moments<L, T>(f);
+        equilibrium<L, T>(m.rho, m.u, feq);
+        op.template collide<L, T>(f, feq, nullptr, out);
+      }
+#pragma GCC unroll 19
+      for (int i = 0; i < Q; ++i) dst[i * N + n + off[i]] = out[i];
+    }
+  });
+}
+
+/// Sets every interior node to the equilibrium of (ρ, u(x)) given by init(Index) -> (ρ, Vec).
+template <class L, class T, class Init>
+void initialise_equilibrium(field::Populations<L, T>& pop, Init&& init) {
+  const auto& g = pop.grid();
+  field::for_each_interior<L::d>(g, [&](const Index<L::d>& ijk) {
+    const auto [rho, u] = init(ijk);
+    std::array<T, L::d> uu;
+    for (int a = 0; a < L::d; ++a) uu[a] = T(u[a]);
+    T feq[L::q];
+    equilibrium<L, T>(T(rho), uu, feq);
+    const auto n = g.index(ijk);
+    for (int i = 0; i < L::q; ++i) pop(i, n) = feq[i];
+  });
+}
+
+/// ρ and u (with half the force) of node n from the current buffer.
+template <class L, class T>
+Moments<L, double> node_moments(const field::Populations<L, T>& pop, std::ptrdiff_t n,
+                                const field::VectorField<L::d, double>* force = nullptr) {
+  double f[L::q];
+  for (int i = 0; i < L::q; ++i) f[i] = pop(i, n);
+  double F[L::d] = {};
+  if (force)
+    for (int a = 0; a < L::d; ++a) F[a] = force->comp[a][n];
+  return moments<L, double>(f, force ? F : nullptr);
+}
+
+}  // namespace caplab::collision

@@ -1,0 +1,539 @@
+// Case loading: the canonical cylinder case at every fidelity level, `--set` overrides, the
+// resolved JSON, catalogue/schema.json against the loader's own description of the format,
+// and one rejection per kind of bad input — each asserting the JSON path of the error and the
+// words that tell the user what to fix.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "case/case_schema.hpp"
+#include "case/load_case.hpp"
+#include "core/error.hpp"
+
+namespace caplab::cases {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+// Suites are named case_* so that `ctest -R case` selects them.
+const fs::path source_dir{CAPLAB_SOURCE_DIR};
+const fs::path cylinder_file = source_dir / "catalogue/ch2/cylinder_re100.json";
+
+
+/// Runs `f`, expects a core::InputError at JSON path `path` whose message contains `path` (when
+/// not empty) and every one of `words`.
+void expect_rejected(const std::function<void()>& f, const std::string& path,
+                     const std::vector<std::string>& words) {
+  try {
+    f();
+  } catch (const core::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.json_path(), path) << what;
+    if (!path.empty()) {
+      EXPECT_NE(what.find(path), std::string::npos) << "no path " << path << " in: " << what;
+    }
+    for (const auto& w : words)
+      EXPECT_NE(what.find(w), std::string::npos) << "no \"" << w << "\" in: " << what;
+    if (std::getenv("CAPLAB_PRINT_ERRORS")) std::printf("%s\n", what.c_str());
+    return;
+  }
+  ADD_FAILURE() << "accepted, but should be rejected at " << path;
+}
+
+void expect_set_rejected(const std::vector<std::string>& overrides, const std::string& path,
+                         const std::vector<std::string>& words) {
+  expect_rejected([&] { load_case(cylinder_file, "standard", overrides); }, path, words);
+}
+
+void expect_doc_rejected(const json& doc, const std::string& path, const std::vector<std::string>& words) {
+  expect_rejected([&] { parse_case(doc, "edited.json", "standard", {}); }, path, words);
+}
+
+json cylinder_json() { return read_case_json(cylinder_file); }
+
+// A temporary file with the given text, removed at the end of the test.
+class TempFile {
+ public:
+  explicit TempFile(const std::string& text)
+      : path_(fs::temp_directory_path() /
+              ("caplab_case_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+               ".json")) {
+    std::ofstream(path_) << text;
+  }
+  ~TempFile() { fs::remove(path_); }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// ---------------------------------------------------------------- the canonical case
+
+void expect_cylinder_common(const CaseSpec& spec) {
+  EXPECT_EQ(spec.id, "ch2/cylinder_re100");
+  EXPECT_EQ(spec.source_file, cylinder_file.string());
+  const PhysicsSpec& p = spec.physics;
+  EXPECT_EQ(p.dimension, 2);
+  EXPECT_EQ(p.flow.type, FlowSpec::Type::uniform);
+  EXPECT_EQ(p.flow.direction, (std::vector<double>{1, 0}));
+  EXPECT_DOUBLE_EQ(p.reynolds, 100);
+  EXPECT_EQ(p.domain_size, (std::vector<double>{30, 20}));
+  EXPECT_EQ(p.boundaries, (std::vector<BoundaryType>{BoundaryType::far_field, BoundaryType::far_field}));
+  ASSERT_EQ(p.bodies.size(), 1u);
+  EXPECT_EQ(p.bodies[0].name, "cylinder");
+  EXPECT_EQ(p.bodies[0].shape.type, ShapeSpec::Type::circle);
+  EXPECT_EQ(p.bodies[0].shape.center, (std::vector<double>{10, 10}));
+  EXPECT_DOUBLE_EQ(p.bodies[0].shape.diameter, 1);
+  EXPECT_EQ(p.bodies[0].motion.type, RigidMotionSpec::Type::fixed);
+
+  const NumericsSpec& n = spec.numerics;
+  EXPECT_EQ(n.grid.refinement, GridSpec::Refinement::two_level);
+  EXPECT_EQ(n.grid.fine_min, (std::vector<double>{8, 8}));
+  EXPECT_EQ(n.grid.fine_max, (std::vector<double>{16, 12}));
+  EXPECT_EQ(n.collision.op, CollisionSpec::Operator::bgk);
+  EXPECT_EQ(n.precision, Precision::double_);
+  EXPECT_EQ(n.ib.kernel, IbSpec::Kernel::cosine4);
+  EXPECT_DOUBLE_EQ(n.ib.marker_spacing, 0.79);
+  EXPECT_EQ(n.ib.forcing_iterations, 1);
+  EXPECT_DOUBLE_EQ(n.lattice_velocity, 0.1);
+  EXPECT_EQ(n.threads, 0);
+
+  EXPECT_DOUBLE_EQ(spec.outputs.series.interval, 0.1);
+  EXPECT_EQ(spec.outputs.series.quantities,
+            (std::vector<std::string>{"drag_coefficient", "lift_coefficient"}));
+  EXPECT_EQ(spec.outputs.snapshots.fields, (std::vector<std::string>{"vorticity"}));
+  ASSERT_EQ(spec.acceptance.size(), 1u);
+  const AcceptanceSpec& a = spec.acceptance[0];
+  EXPECT_EQ(a.metric, "drag_coefficient_mean");
+  EXPECT_DOUBLE_EQ(a.reference_value, 1.438);
+  EXPECT_EQ(a.comparison, "relative");
+  EXPECT_EQ(a.tolerance,
+            (std::map<std::string, double>{{"quick", 0.06}, {"standard", 0.02}, {"thesis", 0.02}}));
+  EXPECT_FALSE(a.justification.empty());
+}
+
+TEST(case_cylinder, LoadsAtStandardAndThesis) {
+  for (const std::string level : {"standard", "thesis"}) {
+    SCOPED_TRACE(level);
+    const CaseSpec spec = load_case(cylinder_file, level);
+    expect_cylinder_common(spec);
+    EXPECT_EQ(spec.fidelity, level);
+    EXPECT_DOUBLE_EQ(spec.numerics.grid.fine_spacing, 0.02);
+    EXPECT_DOUBLE_EQ(spec.numerics.end_time, 250);
+    EXPECT_EQ(spec.outputs.snapshots.times, (std::vector<double>{250}));
+    EXPECT_DOUBLE_EQ(spec.outputs.average_from, 150);
+  }
+}
+
+TEST(case_cylinder, QuickLevelCoarsensTheGridAndShortensTheRun) {
+  const CaseSpec spec = load_case(cylinder_file, "quick");
+  expect_cylinder_common(spec);
+  EXPECT_EQ(spec.fidelity, "quick");
+  EXPECT_DOUBLE_EQ(spec.numerics.grid.fine_spacing, 0.04);
+  EXPECT_DOUBLE_EQ(spec.numerics.end_time, 150);
+  EXPECT_DOUBLE_EQ(spec.resolved["numerics"]["grid"]["fine_spacing"].get<double>(), 0.04);
+}
+
+TEST(case_cylinder, ListsItsFidelityLevels) {
+  EXPECT_EQ(fidelity_levels(cylinder_file), (std::vector<std::string>{"quick", "standard", "thesis"}));
+}
+
+TEST(case_cylinder, DefaultLevelIsStandard) { EXPECT_EQ(load_case(cylinder_file).fidelity, "standard"); }
+
+// Every catalogue case must load at every level it defines.
+TEST(case_catalogue, EveryCaseLoadsAtEveryLevel) {
+  for (const auto& entry : fs::recursive_directory_iterator(source_dir / "catalogue")) {
+    if (entry.path().extension() != ".json" || entry.path().filename() == "schema.json") continue;
+    for (const auto& level : fidelity_levels(entry.path())) {
+      SCOPED_TRACE(entry.path().string() + " at " + level);
+      EXPECT_NO_THROW(load_case(entry.path(), level));
+    }
+  }
+}
+
+// ---------------------------------------------------------------- overrides and resolved JSON
+
+TEST(case_overrides, SetNumberStringAndArrayEntry) {
+  const CaseSpec spec =
+      load_case(cylinder_file, "standard",
+                {"physics.reynolds=200", "numerics.ib.kernel=roma3", "physics.bodies.0.shape.center.1=10.5",
+                 "outputs.series.quantities=[\"drag_coefficient\"]"});
+  EXPECT_DOUBLE_EQ(spec.physics.reynolds, 200);
+  EXPECT_EQ(spec.numerics.ib.kernel, IbSpec::Kernel::roma3);
+  EXPECT_EQ(spec.physics.bodies[0].shape.center, (std::vector<double>{10, 10.5}));
+  EXPECT_EQ(spec.outputs.series.quantities, (std::vector<std::string>{"drag_coefficient"}));
+  EXPECT_EQ(spec.resolved["physics"]["reynolds"], 200);
+  EXPECT_EQ(spec.resolved["numerics"]["ib"]["kernel"], "roma3");
+}
+
+TEST(case_overrides, ApplyAfterTheFidelityLevelAndInOrder) {
+  const CaseSpec spec = load_case(
+      cylinder_file, "quick", {"numerics.end_time=200", "numerics.end_time=180"});
+  EXPECT_DOUBLE_EQ(spec.numerics.end_time, 180);
+  EXPECT_DOUBLE_EQ(spec.numerics.grid.fine_spacing, 0.04);
+}
+
+TEST(case_overrides, CreateOptionalKeysTheSchemaAllows) {
+  json doc = cylinder_json();
+  doc["numerics"].erase("ib");
+  const CaseSpec spec = parse_case(doc, "edited.json", "standard",
+                                   {"numerics.collision.operator=trt", "numerics.collision.magic=0.1875",
+                                    "numerics.ib.forcing_iterations=3", "numerics.threads=4"});
+  EXPECT_EQ(spec.numerics.collision.op, CollisionSpec::Operator::trt);
+  EXPECT_DOUBLE_EQ(spec.numerics.collision.magic, 0.1875);
+  EXPECT_EQ(spec.numerics.ib.forcing_iterations, 3);
+  EXPECT_EQ(spec.numerics.ib.kernel, IbSpec::Kernel::cosine4);  // default kept
+  EXPECT_EQ(spec.numerics.threads, 4);
+}
+
+TEST(case_resolved, RecordsDefaultsNormalisesAndReloadsToTheSameCase) {
+  json doc = cylinder_json();
+  doc["numerics"].erase("ib");
+  doc["physics"]["flow"]["direction"] = {3, 4};
+  const CaseSpec spec = parse_case(doc, "edited.json", "standard", {});
+  EXPECT_NEAR(spec.physics.flow.direction[0], 0.6, 1e-15);
+  EXPECT_NEAR(spec.physics.flow.direction[1], 0.8, 1e-15);
+  EXPECT_EQ(spec.resolved["numerics"]["ib"],
+            (json{{"kernel", "cosine4"}, {"marker_spacing", 0.79}, {"forcing_iterations", 1}}));
+  EXPECT_EQ(spec.resolved["numerics"]["threads"], 0);
+  const CaseSpec again = parse_case(spec.resolved, "case.json", "standard", {});
+  EXPECT_EQ(again.resolved, spec.resolved);
+}
+
+TEST(case_resolved, UniformFlowDirectionDefaultsToPlusX) {
+  json doc = cylinder_json();
+  doc["physics"]["flow"].erase("direction");
+  EXPECT_EQ(parse_case(doc, "edited.json", "standard", {}).physics.flow.direction,
+            (std::vector<double>{1, 0}));
+}
+
+TEST(case_resolved, UniformRefinementNeedsNoFineRegion) {
+  json doc = cylinder_json();
+  doc["numerics"]["grid"] = {{"refinement", "uniform"}, {"fine_spacing", 0.05}};
+  const CaseSpec spec = parse_case(doc, "edited.json", "standard", {});
+  EXPECT_EQ(spec.numerics.grid.refinement, GridSpec::Refinement::uniform);
+  EXPECT_TRUE(spec.numerics.grid.fine_min.empty());
+}
+
+// ---------------------------------------------------------------- rejected input: structure
+
+TEST(case_rejects, UnknownKeyWithDidYouMean) {
+  json doc = cylinder_json();
+  doc["physics"]["reynold"] = doc["physics"]["reynolds"];
+  doc["physics"].erase("reynolds");
+  expect_doc_rejected(doc, "/physics/reynold",
+                      {"edited.json", "unknown key \"reynold\"", "did you mean \"reynolds\"?"});
+}
+
+TEST(case_rejects, UnknownOverridePathWithDidYouMean) {
+  expect_set_rejected({"numerics.grid.fine_spacng=0.04"}, "/numerics/grid/fine_spacng",
+                      {"--set numerics.grid.fine_spacng=0.04", "did you mean \"fine_spacing\"?"});
+  expect_set_rejected({"physics.reynolds.x=1"}, "/physics/reynolds/x", {"has no member \"x\""});
+  expect_set_rejected({"physics.bodies.1.name=b"}, "/physics/bodies/1", {"index", "it has 1 entries"});
+  json doc = cylinder_json();
+  doc["outputs"].erase("snapshots");
+  expect_rejected([&] { parse_case(doc, "edited.json", "standard", {"outputs.snapshots.times.0=1"}); },
+                  "/outputs/snapshots/times/0", {"the array at /outputs/snapshots/times is empty or absent"});
+  expect_set_rejected({"fidelity.quick=1"}, "/fidelity", {"levels are applied before overrides"});
+  expect_set_rejected({"physics.reynolds"}, "", {"path=value"});
+}
+
+TEST(case_rejects, BadPathInAFidelityLevelThatIsNotApplied) {
+  json doc = cylinder_json();
+  doc["fidelity"]["thesis"]["numerics.grid.fine_spacing_"] = 0.02;
+  expect_doc_rejected(doc, "/fidelity/thesis/numerics.grid.fine_spacing_",
+                      {"\"fine_spacing_\" is not a key of /numerics/grid", "did you mean \"fine_spacing\"?"});
+}
+
+TEST(case_rejects, MissingRequiredKey) {
+  json doc = cylinder_json();
+  doc["physics"].erase("reynolds");
+  expect_doc_rejected(doc, "/physics/reynolds",
+                      {"required key \"reynolds\" is missing", "a finite number > 0"});
+}
+
+TEST(case_rejects, WrongType) {
+  expect_set_rejected({"physics.reynolds=\"100\""}, "/physics/reynolds",
+                      {"\"100\" (a string; write numbers without quotes)", "a finite number"});
+  expect_set_rejected({"physics.dimension=2.5"}, "/physics/dimension",
+                      {"2.5 (not an integer)", "an integer in [2, 3]"});
+  expect_set_rejected({"physics.bodies={}"}, "/physics/bodies", {"(an object)", "an array"});
+}
+
+TEST(case_rejects, NanAndInfinity) {
+  // "nan" is not JSON, so the override value is the string "nan".
+  expect_set_rejected({"physics.reynolds=nan"}, "/physics/reynolds",
+                      {"NaN and infinity are not allowed", "a finite number", "--set physics.reynolds=nan"});
+  expect_set_rejected({"numerics.end_time=1e999"}, "/numerics/end_time",
+                      {"NaN and infinity are not allowed"});
+  json doc = cylinder_json();
+  doc["physics"]["domain"]["size"][1] = std::nan("");
+  expect_doc_rejected(doc, "/physics/domain/size/1", {"nan", "a finite number > 0"});
+}
+
+TEST(case_rejects, BadEnumerationListsTheAllowedValues) {
+  expect_set_rejected({"numerics.collision.operator=mrt"}, "/numerics/collision/operator",
+                      {"\"mrt\"", "one of \"bgk\", \"trt\""});
+  expect_set_rejected({"physics.domain.boundaries.1=farfield"}, "/physics/domain/boundaries/1",
+                      {"one of \"periodic\", \"far_field\", \"wall\"", "did you mean \"far_field\"?"});
+}
+
+TEST(case_rejects, UnknownFidelityLevelListsTheDefinedOnes) {
+  expect_rejected([] { load_case(cylinder_file, "standrad"); }, "/fidelity",
+                  {"\"standrad\"", "\"quick\", \"standard\", \"thesis\"", "did you mean \"standard\"?"});
+}
+
+TEST(case_rejects, VectorWithTheWrongNumberOfEntries) {
+  expect_set_rejected({"physics.domain.size=[30, 20, 20]"}, "/physics/domain/size",
+                      {"2 entries, one per axis", "physics.dimension is 2"});
+}
+
+// ---------------------------------------------------------------- rejected input: values
+
+TEST(case_rejects, NegativeReynolds) {
+  expect_set_rejected({"physics.reynolds=-5"}, "/physics/reynolds", {"-5", "a finite number > 0", "--set"});
+}
+
+TEST(case_rejects, OutOfRangeNumbers) {
+  expect_set_rejected({"numerics.lattice_velocity=0.5"}, "/numerics/lattice_velocity",
+                      {"0.5", "in (0, 0.4]"});
+  expect_set_rejected({"numerics.ib.forcing_iterations=0"}, "/numerics/ib/forcing_iterations", {">= 1"});
+  expect_set_rejected({"acceptance.0.tolerance.standard=0"}, "/acceptance/0/tolerance/standard", {"> 0"});
+  expect_set_rejected({"acceptance.0.justification=\"\""}, "/acceptance/0/justification",
+                      {"a non-empty string"});
+}
+
+TEST(case_rejects, ValueSetByAFidelityLevelNamesTheLevel) {
+  json doc = cylinder_json();
+  doc["fidelity"]["standard"]["numerics.end_time"] = -1;
+  expect_doc_rejected(doc, "/numerics/end_time", {"-1 (set by fidelity level \"standard\")", "> 0"});
+}
+
+// ---------------------------------------------------------------- rejected input: consistency
+
+TEST(case_rejects, SpacingThatDoesNotDivideTheDomain) {
+  expect_set_rejected({"numerics.grid.fine_spacing=0.07"}, "/numerics/grid/fine_spacing",
+                      {"along x (30)", "whole multiple of 2*fine_spacing",
+                       "nearest valid fine_spacing for this axis "
+                       "is 30/428"});
+}
+
+TEST(case_rejects, AbsurdNumberOfNodes) {
+  expect_set_rejected({"numerics.grid.fine_spacing=0.0001"}, "/numerics/grid/fine_spacing",
+                      {"at most 2e+09 lattice nodes"});
+}
+
+TEST(case_rejects, BodyOutsideTheFineRegion) {
+  expect_set_rejected({"physics.bodies.0.shape.center=[15.8, 10]"}, "/physics/bodies/0/shape/center",
+                      {"body \"cylinder\"", "inside the fine region", "3 fine spacings", "along x"});
+}
+
+TEST(case_rejects, BodyOutsideTheDomain) {
+  expect_set_rejected({"physics.bodies.0.shape.center=[10, 19.8]"}, "/physics/bodies/0/shape/center",
+                      {"body \"cylinder\"", "inside the domain", "along y"});
+}
+
+TEST(case_rejects, FineRegionOutsideTheDomainOrOffTheCoarseNodes) {
+  expect_set_rejected({"numerics.grid.fine_region.max.0=32"}, "/numerics/grid/fine_region/max/0",
+                      {"inside the domain [0, 30] along x", "4 coarse spacings"});
+  expect_set_rejected({"numerics.grid.fine_region.min.1=0.08"}, "/numerics/grid/fine_region/min/1",
+                      {"along y", "min >= 0.16"});
+  expect_set_rejected({"numerics.grid.fine_region.min.0=8.01"}, "/numerics/grid/fine_region/min/0",
+                      {"on a coarse node", "nearest is 8"});
+  expect_set_rejected({"numerics.grid.fine_region.min=[16, 8]"}, "/numerics/grid/fine_region",
+                      {"min < max", "along x"});
+}
+
+TEST(case_rejects, FineRegionPresenceMustMatchRefinement) {
+  expect_set_rejected({"numerics.grid.refinement=uniform"}, "/numerics/grid/fine_region",
+                      {"applies only when /numerics/grid/refinement is \"two_level\"", "\"uniform\" here"});
+  json doc = cylinder_json();
+  doc["numerics"]["grid"].erase("fine_region");
+  expect_doc_rejected(doc, "/numerics/grid/fine_region",
+                      {"missing", "required when /numerics/grid/refinement"});
+}
+
+TEST(case_rejects, MagicWithBgk) {
+  expect_set_rejected({"numerics.collision.magic=0.25"}, "/numerics/collision/magic",
+                      {"applies only when /numerics/collision/operator is \"trt\"", "\"bgk\" here",
+                       "set by --set numerics.collision.magic=0.25"});
+}
+
+TEST(case_rejects, DirectionForANonUniformFlowAndZeroDirection) {
+  expect_set_rejected({"physics.flow.type=rest"}, "/physics/flow/direction",
+                      {"applies only when", "\"uniform\""});
+  expect_set_rejected({"physics.flow.direction=[0, 0]"}, "/physics/flow/direction", {"a non-zero vector"});
+}
+
+TEST(case_rejects, CircleIn3DAndSphereIn2D) {
+  expect_set_rejected(
+      {"physics.dimension=3", "physics.flow.direction=[1, 0, 0]", "physics.domain.size=[30, 20, 20]",
+       "physics.domain.boundaries=[\"far_field\", \"far_field\", \"far_field\"]",
+       "physics.bodies.0.shape.center=[10, 10, 10]", "numerics.grid.fine_region.min=[8, 8, 8]",
+       "numerics.grid.fine_region.max=[16, 12, 12]"},
+      "/physics/bodies/0/shape/type", {"\"circle\"", "3D shape for body \"cylinder\"", "\"sphere\""});
+  expect_set_rejected({"physics.bodies.0.shape.type=sphere"}, "/physics/bodies/0/shape/type",
+                      {"2D shape", "\"circle\""});
+}
+
+TEST(case_rejects, OutputTimesBeyondTheEnd) {
+  expect_set_rejected({"outputs.snapshots.times=[100, 300]"}, "/outputs/snapshots/times/1",
+                      {"300", "[0, 250]"});
+  expect_set_rejected({"outputs.average_from=250"}, "/outputs/average_from",
+                      {"[0, 250)", "must not be empty"});
+}
+
+TEST(case_rejects, ToleranceForAnUndefinedOrMissingLevel) {
+  expect_set_rejected({"acceptance.0.tolerance.thesys=0.02"}, "/acceptance/0/tolerance/thesys",
+                      {"did you mean \"thesis\"?"});
+  json doc = cylinder_json();
+  doc["acceptance"][0]["tolerance"].erase("thesis");
+  expect_doc_rejected(doc, "/acceptance/0/tolerance", {"no tolerance for fidelity level \"thesis\""});
+}
+
+TEST(case_rejects, DuplicateBodyNames) {
+  json doc = cylinder_json();
+  json second = doc["physics"]["bodies"][0];
+  second["shape"]["center"] = {13, 10};
+  doc["physics"]["bodies"].push_back(second);
+  expect_doc_rejected(doc, "/physics/bodies/1/name", {"\"cylinder\"", "not used by another body"});
+}
+
+// ---------------------------------------------------------------- rejected input: files
+
+TEST(case_rejects, FileThatDoesNotExist) {
+  expect_rejected([] { load_case(source_dir / "catalogue/no_such_case.json"); }, "",
+                  {"no_such_case.json", "no such file"});
+}
+
+TEST(case_rejects, MalformedJsonWithLineAndColumn) {
+  const TempFile file("{\n  \"id\": \"x\",\n  \"title\": ,\n}\n");
+  expect_rejected([&] { load_case(file.path()); }, "",
+                  {file.path().filename().string(), "malformed JSON", "line 3, column 12"});
+}
+
+TEST(case_rejects, KeyRepeatedInOneObject) {
+  const TempFile file("{\"physics\": {\"bodies\": [{\"name\": \"a\"}, {\"name\": \"b\", \"name\": \"c\"}]}}");
+  expect_rejected([&] { load_case(file.path()); }, "/physics/bodies/1/name",
+                  {"the key \"name\" a second time", "at most once"});
+}
+
+// ---------------------------------------------------------------- catalogue/schema.json
+
+json schema_json() {
+  std::ifstream in(source_dir / "catalogue/schema.json");
+  return json::parse(in);
+}
+
+// Follows "$ref": "#/$defs/..." within the schema document.
+const json& resolve(const json& root, const json& node) {
+  return node.contains("$ref") ? root.at(json::json_pointer(node.at("$ref").get<std::string>().substr(1)))
+                               : node;
+}
+
+// The keys schema.json declares, in the form of schema_keys(): dotted path ("*" for array
+// entries), whether the object requires it, and the enum of the value or of its entries.
+std::set<std::tuple<std::string, bool, std::vector<std::string>>> published_keys(const json& root,
+                                                                                 const json& node,
+                                                                                 const std::string& path) {
+  std::set<std::tuple<std::string, bool, std::vector<std::string>>> keys;
+  const json& n = resolve(root, node);
+  if (n.contains("items")) return published_keys(root, n.at("items"), path + ".*");
+  if (!n.contains("properties")) return keys;
+  const json required = n.value("required", json::array());
+  for (const auto& [key, sub] : n.at("properties").items()) {
+    const std::string p = path.empty() ? key : path + "." + key;
+    const json& s = resolve(root, sub);
+    const json& leaf = s.contains("items") ? resolve(root, s.at("items")) : s;
+    keys.emplace(p, std::find(required.begin(), required.end(), key) != required.end(),
+                 leaf.value("enum", std::vector<std::string>{}));
+    keys.merge(published_keys(root, sub, p));
+  }
+  return keys;
+}
+
+std::set<std::tuple<std::string, bool, std::vector<std::string>>> loader_keys() {
+  std::set<std::tuple<std::string, bool, std::vector<std::string>>> keys;
+  for (const auto& k : schema_keys()) keys.emplace(k.path, k.required, k.choices);
+  return keys;
+}
+
+TEST(case_schema, IsDraft202012AndDescribesEveryKey) {
+  const json schema = schema_json();
+  EXPECT_EQ(schema["$schema"], "https://json-schema.org/draft/2020-12/schema");
+  std::function<void(const json&, const std::string&)> check = [&](const json& node,
+                                                                   const std::string& where) {
+    const json& n = resolve(schema, node);
+    if (n.contains("items")) check(n["items"], where + "/items");
+    if (!n.contains("properties")) return;
+    for (const auto& [key, sub] : n["properties"].items()) {
+      EXPECT_TRUE(sub.contains("description")) << where << "/" << key << " has no description";
+      check(sub, where + "/" + key);
+    }
+  };
+  check(schema, "");
+}
+
+TEST(case_schema, EveryKeyOfTheExampleIsInTheSchema) {
+  const json schema = schema_json();
+  std::function<void(const json&, const json&, const std::string&)> walk =
+      [&](const json& value, const json& node, const std::string& where) {
+        const json& n = resolve(schema, node);
+        if (value.is_array() && n.contains("items"))
+          for (const auto& v : value) walk(v, n["items"], where + "/*");
+        if (!value.is_object() || !n.contains("properties")) return;  // free-key maps (fidelity, tolerance)
+        for (const auto& [key, v] : value.items()) {
+          ASSERT_TRUE(n["properties"].contains(key)) << where << "/" << key << " is not in schema.json";
+          walk(v, n["properties"][key], where + "/" + key);
+        }
+      };
+  walk(cylinder_json(), schema, "");
+}
+
+TEST(case_schema, PublishedSchemaAndLoaderAgreeOnKeysRequirementsAndEnums) {
+  const auto published = published_keys(schema_json(), schema_json(), "");
+  const auto loader = loader_keys();
+  for (const auto& k : loader)
+    EXPECT_TRUE(published.count(k)) << "schema.json lacks or differs on " << std::get<0>(k);
+  for (const auto& k : published)
+    EXPECT_TRUE(loader.count(k)) << "loader lacks or differs on " << std::get<0>(k);
+  EXPECT_TRUE(loader.count({"physics.reynolds", true, {}}));  // the enumeration itself works
+}
+
+TEST(case_schema, ComparisonDetectsADifference) {
+  json schema = schema_json();
+  schema["properties"]["physics"]["properties"].erase("reynolds");
+  EXPECT_NE(published_keys(schema, schema, ""), loader_keys());
+  schema = schema_json();
+  schema["properties"]["numerics"]["properties"]["collision"]["properties"]["operator"]["enum"].push_back(
+      "mrt");
+  EXPECT_NE(published_keys(schema, schema, ""), loader_keys());
+}
+
+TEST(case_schema, DefaultsMatchTheSpecDefaults) {
+  const json schema = schema_json();
+  const json& numerics = schema["properties"]["numerics"]["properties"];
+  const CaseSpec defaults;
+  EXPECT_EQ(numerics["ib"]["properties"]["kernel"]["default"], "cosine4");
+  EXPECT_EQ(defaults.numerics.ib.kernel, IbSpec::Kernel::cosine4);
+  EXPECT_EQ(numerics["ib"]["properties"]["marker_spacing"]["default"], defaults.numerics.ib.marker_spacing);
+  EXPECT_EQ(numerics["ib"]["properties"]["forcing_iterations"]["default"],
+            defaults.numerics.ib.forcing_iterations);
+  EXPECT_EQ(numerics["collision"]["properties"]["magic"]["default"], defaults.numerics.collision.magic);
+  EXPECT_EQ(numerics["threads"]["default"], defaults.numerics.threads);
+  EXPECT_EQ(schema["properties"]["outputs"]["properties"]["average_from"]["default"],
+            defaults.outputs.average_from);
+}
+
+}  // namespace
+}  // namespace caplab::cases

@@ -1,0 +1,238 @@
+// IB transfer: adjointness of interpolation and spreading (2D, 3D, every kernel, with and
+// without periodic wrap), exactness on polynomials, conservation, periodic wrap, the
+// out-of-block error, and buffer reuse.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "ibm/transfer.hpp"
+#include "ibm_test_util.hpp"
+
+namespace caplab::ibm {
+namespace {
+
+using testing::make_grid;
+using testing::random_positions;
+using testing::random_vec;
+using testing::sum_interior;
+
+template <int Dim, class K, bool Periodic>
+struct Config {
+  static constexpr int D = Dim;
+  using Kernel = K;
+  static constexpr bool periodic = Periodic;
+};
+
+template <class C>
+class TransferTest : public ::testing::Test {};
+using Configs = ::testing::Types<Config<2, Cosine4, false>, Config<2, Cosine4, true>, Config<2, Roma3, false>,
+                                 Config<2, Linear2, true>, Config<3, Cosine4, false>,
+                                 Config<3, Cosine4, true>, Config<3, Roma3, true>, Config<3, Linear2, false>>;
+TYPED_TEST_SUITE(TransferTest, Configs);
+
+template <class C>
+std::array<bool, C::D> periodic_flags() {
+  std::array<bool, C::D> p;
+  p.fill(C::periodic);
+  return p;
+}
+
+// Marker lattice coordinates: anywhere (even outside the block) when periodic, otherwise far
+// enough from the edges for the stencil.
+template <class C>
+std::vector<Vec<C::D>> markers(const field::Grid<C::D>& g, int count, std::mt19937& rng) {
+  const int n = g.n()[0];
+  return C::periodic ? random_positions<C::D>(g, count, -3.0, n + 3.0, rng)
+                     : random_positions<C::D>(g, count, 2.0, n - 3.0, rng);
+}
+
+TYPED_TEST(TransferTest, InterpolationAndSpreadingAreAdjoint) {
+  constexpr int D = TypeParam::D;
+  std::mt19937 rng(42);
+  const auto g = make_grid<D>(D == 2 ? 24 : 12);
+  const auto x = markers<TypeParam>(g, 60, rng);
+  std::vector<Vec<D>> u(g.size());
+  for (auto& v : u) v = random_vec<D>(rng, -1.0, 1.0);
+  std::vector<Vec<D>> force(x.size());
+  std::vector<double> w(x.size());
+  for (std::size_t m = 0; m < x.size(); ++m) {
+    force[m] = random_vec<D>(rng, -1.0, 1.0);
+    w[m] = std::uniform_real_distribution<double>(0.3, 1.2)(rng);
+  }
+  Transfer<D, typename TypeParam::Kernel> t;
+  t.update(g, periodic_flags<TypeParam>(), x);
+  std::vector<Vec<D>> ux(x.size());
+  t.interpolate([&](const Index<D>&, std::ptrdiff_t id) { return u[id]; }, ux);
+  field::VectorField<D> f(g.size());
+  t.spread(force, w, f);
+
+  double lagrangian = 0.0, scale = 0.0;
+  for (std::size_t m = 0; m < x.size(); ++m) {
+    lagrangian += ux[m].dot(force[m]) * w[m];
+    scale += ux[m].norm() * force[m].norm() * w[m];
+  }
+  const double eulerian = sum_interior<D>(g, 0.0, [&](const Index<D>&, std::ptrdiff_t id) {
+    double s = 0.0;
+    for (int a = 0; a < D; ++a) s += u[id][a] * f.comp[a][id];
+    return s;
+  });
+  EXPECT_NEAR(lagrangian, eulerian, 1e-13 * scale);
+  // The comparator must be able to fail: a perturbed field breaks the identity.
+  f.comp[0][g.index(t.stencil_indices(0)[1])] += 1e-3;
+  const double perturbed = sum_interior<D>(g, 0.0, [&](const Index<D>&, std::ptrdiff_t id) {
+    double s = 0.0;
+    for (int a = 0; a < D; ++a) s += u[id][a] * f.comp[a][id];
+    return s;
+  });
+  EXPECT_GT(std::abs(lagrangian - perturbed), 1e3 * 1e-13 * scale);
+}
+
+TYPED_TEST(TransferTest, SpreadingConservesForceAndLeavesGhostsAlone) {
+  constexpr int D = TypeParam::D;
+  std::mt19937 rng(7);
+  const auto g = make_grid<D>(D == 2 ? 20 : 10);
+  const auto x = markers<TypeParam>(g, 40, rng);
+  std::vector<Vec<D>> force(x.size());
+  std::vector<double> w(x.size(), 0.7);
+  Vec<D> total = Vec<D>::Zero();
+  for (std::size_t m = 0; m < x.size(); ++m) {
+    force[m] = random_vec<D>(rng, -1.0, 1.0);
+    total += force[m] * w[m];
+  }
+  Transfer<D, typename TypeParam::Kernel> t;
+  t.update(g, periodic_flags<TypeParam>(), x);
+  for (std::size_t m = 0; m < x.size(); ++m) {
+    double s = 0.0;
+    for (double we : t.stencil_weights(m)) s += we;
+    EXPECT_NEAR(s, 1.0, 1e-14);
+  }
+  field::VectorField<D> f(g.size());
+  t.spread(force, w, f);
+  const Vec<D> grid_total =
+      sum_interior<D>(g, Vec<D>(Vec<D>::Zero()), [&](const Index<D>&, std::ptrdiff_t id) {
+        Vec<D> v;
+        for (int a = 0; a < D; ++a) v[a] = f.comp[a][id];
+        return v;
+      });
+  EXPECT_NEAR((grid_total - total).norm(), 0.0, 1e-13 * x.size());
+  field::for_each_ghost(g, [&](const Index<D>& ijk) {
+    for (int a = 0; a < D; ++a) EXPECT_EQ(f.comp[a][g.index(ijk)], 0.0);
+  });
+}
+
+TYPED_TEST(TransferTest, InterpolationExactOnUniformAndLinearFields) {
+  constexpr int D = TypeParam::D;
+  using K = typename TypeParam::Kernel;
+  std::mt19937 rng(3);
+  const auto g = make_grid<D>(D == 2 ? 20 : 10);
+  // Inside the block so that the linear field is not cut by the periodic wrap.
+  const auto x = random_positions<D>(g, 30, 2.0, g.n()[0] - 3.0, rng);
+  Transfer<D, K> t;
+  t.update(g, periodic_flags<TypeParam>(), x);
+  const Vec<D> u0 = random_vec<D>(rng, -1.0, 1.0);
+  std::vector<Vec<D>> ux(x.size());
+  t.interpolate([&](const Index<D>&, std::ptrdiff_t) { return u0; }, ux);
+  for (const auto& v : ux) EXPECT_NEAR((v - u0).norm(), 0.0, 1e-14);
+  // u(x) = x along every component (lattice units): exact when the first moment vanishes.
+  std::vector<double> sx(x.size());
+  t.interpolate_scalar([](const Index<D>& ijk, std::ptrdiff_t) { return static_cast<double>(ijk[0]); }, sx);
+  for (std::size_t m = 0; m < x.size(); ++m) {
+    const double err = std::abs(sx[m] - t.lattice_position(m)[0]);
+    if constexpr (std::is_same_v<K, Cosine4>)
+      EXPECT_LT(err, 0.02115);
+    else
+      EXPECT_LT(err, 1e-13);
+  }
+}
+
+TEST(TransferPeriodic, WrapIsTranslationInvariant) {
+  // A periodic field sampled at a marker next to the edge (stencil wraps) equals the same
+  // field shifted by 8 nodes sampled at the marker shifted by 8 nodes (no wrap), and a
+  // marker shifted by a whole period gives the same stencil.
+  constexpr int n = 16;
+  constexpr double pi = std::numbers::pi;
+  const auto g = make_grid<2>(n, 1.0);
+  const std::array<bool, 2> periodic{true, true};
+  auto field = [](int i, int j) {
+    return Vec<2>(std::sin(2 * pi * i / n) + 0.3 * std::cos(4 * pi * j / n), std::cos(2 * pi * (i + j) / n));
+  };
+  auto wrap = [](int i) { return ((i % n) + n) % n; };
+  const Vec<2> x0 = g.origin() + Vec<2>(0.3, 15.6);
+  const Vec<2> shift(8.0, -8.0);
+  std::vector<Vec<2>> a(1), b(1), c(1);
+  interpolate<Cosine4>(
+      g, periodic, std::vector<Vec<2>>{x0},
+      [&](const Index<2>& ij, std::ptrdiff_t) { return field(ij[0], ij[1]); }, a);
+  interpolate<Cosine4>(
+      g, periodic, std::vector<Vec<2>>{x0 + shift},
+      [&](const Index<2>& ij, std::ptrdiff_t) { return field(wrap(ij[0] - 8), wrap(ij[1] + 8)); }, b);
+  interpolate<Cosine4>(
+      g, periodic, std::vector<Vec<2>>{x0 + Vec<2>(-n, 2.0 * n)},
+      [&](const Index<2>& ij, std::ptrdiff_t) { return field(ij[0], ij[1]); }, c);
+  EXPECT_NEAR((a[0] - b[0]).norm(), 0.0, 1e-14);
+  EXPECT_NEAR((a[0] - c[0]).norm(), 0.0, 1e-14);
+
+  // Spreading from the corner reaches nodes on both sides of both periodic edges.
+  field::VectorField<2> f(g.size());
+  spread<Cosine4>(g, periodic, std::vector<Vec<2>>{x0}, std::vector<Vec<2>>{Vec<2>(1.0, 0.0)},
+                  std::vector<double>{1.0}, f);
+  EXPECT_GT(f.comp[0][g.index({0, 15})], 0.0);
+  EXPECT_GT(f.comp[0][g.index({n - 1, 0})], 0.0);
+  EXPECT_GT(f.comp[0][g.index({n - 1, 14})], 0.0);
+}
+
+TEST(TransferErrors, StencilOutsideNonPeriodicBlockIsReported) {
+  const auto g = make_grid<3>(10, 0.5);
+  // Lattice x = 0.5: the cosine stencil needs node -1 along axis 0.
+  const Vec<3> x = g.origin() + 0.5 * Vec<3>(0.5, 4.0, 4.0);
+  Transfer<3, Cosine4> t;
+  try {
+    t.update(g, {false, true, true}, std::vector<Vec<3>>{g.origin() + 0.5 * Vec<3>(4.0, 4.0, 4.0), x});
+    FAIL() << "expected core::Error";
+  } catch (const core::Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("IB marker 1"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("(-0.75, 1.5, 2)"), std::string::npos) << msg;  // physical position
+    EXPECT_NE(msg.find("along axis 0"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("-1 .. 2"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("10 x 10 x 10"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("cosine4"), std::string::npos) << msg;
+  }
+  // The same marker is fine when the axis is periodic, and with the narrower hat kernel.
+  EXPECT_NO_THROW(t.update(g, {true, false, false}, std::vector<Vec<3>>{x}));
+  Transfer<3, Linear2> hat;
+  EXPECT_NO_THROW(hat.update(g, {false, false, false}, std::vector<Vec<3>>{x}));
+  // Upper edge: lattice 7.5 needs node 9 (fine) ... 8.0 needs node 10 (outside).
+  EXPECT_NO_THROW(
+      t.update(g, {false, false, false}, std::vector<Vec<3>>{g.origin() + 0.5 * Vec<3>(7.5, 4, 4)}));
+  EXPECT_THROW(t.update(g, {false, false, false}, std::vector<Vec<3>>{g.origin() + 0.5 * Vec<3>(4, 4, 8.0)}),
+               core::Error);
+  // Diverged markers are reported, not turned into out-of-range indices.
+  EXPECT_THROW(t.update(g, {true, true, true}, std::vector<Vec<3>>{Vec<3>(std::nan(""), 0, 0)}), core::Error);
+}
+
+TEST(TransferBuffers, UpdateReusesStorage) {
+  const auto g = make_grid<3>(12);
+  std::mt19937 rng(1);
+  Transfer<3, Cosine4> t;
+  t.update(g, {true, true, true}, random_positions<3>(g, 50, 0.0, 12.0, rng));
+  const auto* nodes = t.stencil_nodes(0).data();
+  const auto* weights = t.stencil_weights(0).data();
+  t.update(g, {true, true, true}, random_positions<3>(g, 50, 0.0, 12.0, rng));
+  EXPECT_EQ(t.stencil_nodes(0).data(), nodes);
+  EXPECT_EQ(t.stencil_weights(0).data(), weights);
+  EXPECT_EQ(t.stencil_nodes(0).size(), 64u);
+}
+
+TEST(TransferUnits, MeasureToLattice) {
+  EXPECT_DOUBLE_EQ(measure_to_lattice<2>(0.3, 0.1), 3.0);
+  EXPECT_DOUBLE_EQ(measure_to_lattice<3>(0.03, 0.1), 3.0);
+}
+
+}  // namespace
+}  // namespace caplab::ibm
