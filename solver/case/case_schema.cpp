@@ -84,6 +84,7 @@ SchemaNode build_case_schema() {
       req("dimension", integer(closed(2, 3))),
       req("flow", object({req("type", choice(enum_names(flow_type_names))),
                           opt("direction", per_axis(number())),  // uniform only
+                          opt("perturbation", number(closed(0, 1))),  // uniform only
                           opt("body_force", number())})),        // body_force only (required there)
       req("reynolds", number(positive)),
       req("domain", object({req("size", per_axis(number(positive))),
@@ -144,6 +145,7 @@ struct ConditionalKey {
 const std::vector<ConditionalKey>& conditional_keys() {
   static const std::vector<ConditionalKey> rules{
       {"/physics/flow/direction", "/physics/flow/type", {"uniform"}, false},
+      {"/physics/flow/perturbation", "/physics/flow/type", {"uniform"}, false},
       {"/physics/flow/body_force", "/physics/flow/type", {"body_force"}, true},
       {"/numerics/grid/fine_region", "/numerics/grid/refinement", {"two_level"}, true},
       {"/numerics/collision/magic", "/numerics/collision/operator", {"trt"}, false},

@@ -27,6 +27,10 @@ struct FlowSpec {
   Type type = Type::rest;
   std::vector<double> direction;  ///< uniform: unit vector (default +x)
   double body_force = 0.0;        ///< body_force: force density along x, in ρU²/L
+  /// uniform: amplitude (in U) of a transverse velocity blob in the initial condition,
+  /// 1.5 D downstream of each body with width D/2, that breaks the wake's symmetry so that
+  /// shedding starts early instead of waiting for round-off to grow (0: none).
+  double perturbation = 0.0;
 };
 
 /// What happens on the two faces normal to one axis.

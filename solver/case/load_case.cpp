@@ -135,6 +135,7 @@ CaseSpec to_spec(const json& doc) {
   physics.flow.type = enum_value(flow_type_names, flow.at("type").get<std::string>());
   physics.flow.direction = flow.value("direction", physics.flow.direction);
   physics.flow.body_force = flow.value("body_force", physics.flow.body_force);
+  physics.flow.perturbation = flow.value("perturbation", physics.flow.perturbation);
   physics.reynolds = p.at("reynolds").get<double>();
   physics.domain_size = p.at("domain").at("size").get<std::vector<double>>();
   for (const auto& b : p.at("domain").at("boundaries")) {

@@ -8,6 +8,7 @@
 // the fine one (acoustic scaling: a_f = a_c / m).
 #pragma once
 
+#include <chrono>
 #include <functional>
 #include <optional>
 
@@ -87,12 +88,16 @@ class Fluid {
       return;
     }
     advance_block(c, {}, [&] { coarse_bc_.apply(c.pop, c.op); });
-    coupling_.capture_coarse(c.pop);
+    timed(coupling_seconds_, [&] { coupling_.capture_coarse(c.pop); });
     auto& f = blocks_[1];
     for (int sub = 0; sub < 2; ++sub)
-      advance_block(f, hook, [&] { coupling_.fill_fine_ghosts(f.pop, f.op, 0.5 * sub); });
-    coupling_.restrict_to_coarse(c.pop, f.pop);
+      advance_block(f, hook,
+                    [&] { timed(coupling_seconds_, [&] { coupling_.fill_fine_ghosts(f.pop, f.op, 0.5 * sub); }); });
+    timed(coupling_seconds_, [&] { coupling_.restrict_to_coarse(c.pop, f.pop); });
   }
+
+  /// Wall time spent in the multi-block coupling so far (part of the step time).
+  double coupling_seconds() const { return coupling_seconds_; }
 
   bool two_level() const { return blocks_.size() == 2; }
   Block& finest() { return blocks_.back(); }
@@ -132,7 +137,15 @@ class Fluid {
     blk.pop.swap();
   }
 
+  template <class F>
+  static void timed(double& acc, F&& f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    acc += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
   std::vector<Block> blocks_;
+  double coupling_seconds_ = 0;
   std::array<Vec<D>, 2> body_force_{Vec<D>::Zero(), Vec<D>::Zero()};
   boundary::BoundarySet<L, T> coarse_bc_;
   refinement::TwoLevel<L, T> coupling_;

@@ -112,7 +112,7 @@ void expect_cylinder_common(const CaseSpec& spec) {
   EXPECT_EQ(spec.outputs.series.quantities,
             (std::vector<std::string>{"drag_coefficient", "lift_coefficient"}));
   EXPECT_EQ(spec.outputs.snapshots.fields, (std::vector<std::string>{"vorticity"}));
-  ASSERT_EQ(spec.acceptance.size(), 1u);
+  ASSERT_EQ(spec.acceptance.size(), 3u);
   const AcceptanceSpec& a = spec.acceptance[0];
   EXPECT_EQ(a.metric, "drag_coefficient_mean");
   EXPECT_DOUBLE_EQ(a.reference_value, 1.438);

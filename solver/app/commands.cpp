@@ -1,0 +1,99 @@
+#include "app/commands.hpp"
+
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+
+#include "case/load_case.hpp"
+#include "sim/run_case.hpp"
+#include "sim/units.hpp"
+
+namespace caplab::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string human_seconds(double s) {
+  if (s < 90) return fmt::format("{:.0f} s", s);
+  if (s < 5400) return fmt::format("{:.1f} min", s / 60);
+  return fmt::format("{:.1f} h", s / 3600);
+}
+
+/// One line with the derived lattice units (the FluidX3D habit): what the case means on the lattice.
+void print_units(const cases::CaseSpec& spec, const sim::LatticeUnits& u) {
+  fmt::print("{} [{}]: Re = {} ({}), U_lu = {}, Mach = {:.3f}\n", spec.id, spec.fidelity, spec.physics.reynolds,
+             u.reynolds_definition, u.velocity_lu, u.mach);
+  for (const auto& b : u.blocks) {
+    std::string nodes;
+    for (std::size_t a = 0; a < b.nodes.size(); ++a) nodes += (a ? " x " : "") + std::to_string(b.nodes[a]);
+    fmt::print("  block {:8s} dx = {:.5g} L, dt = {:.5g} L/U, tau = {:.5f}, nu_lu = {:.5g}, nodes {}\n", b.name, b.dx,
+               b.dt, b.tau, b.nu_lu, nodes);
+  }
+}
+
+}  // namespace
+
+int check(const CheckArgs& args) {
+  const auto spec = cases::load_case(args.case_file, args.fidelity, args.overrides);
+  const auto u = sim::derive_units(spec);
+  print_units(spec, u);
+  fmt::print("  steps {} (coarse), node updates {:.3g}, memory {:.1f} MiB\n", u.coarse_steps, u.node_updates,
+             u.memory_bytes / (1024.0 * 1024.0));
+  fmt::print("  estimated run time: {} at 50 MLUPS, {} at 150 MLUPS\n", human_seconds(u.estimated_seconds(50)),
+             human_seconds(u.estimated_seconds(150)));
+  fmt::print("ok: {} is valid at fidelity {}\n", args.case_file.string(), spec.fidelity);
+  return 0;
+}
+
+int list(const fs::path& dir) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.path().extension() == ".json" && e.path().filename() != "schema.json") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) {
+    try {
+      const auto spec = cases::load_case(f, "standard");
+      std::string levels;
+      for (const auto& l : cases::fidelity_levels(f)) levels += (levels.empty() ? "" : ",") + l;
+      fmt::print("{:40s} {:10s} {}\n", spec.id, levels, spec.title);
+    } catch (const core::InputError& e) {
+      fmt::print("{:40s} INVALID    {}\n", f.string(), e.what());
+    }
+  }
+  return 0;
+}
+
+int run(const RunArgs& args, bool terminal) {
+  const auto spec = cases::load_case(args.case_file, args.fidelity, args.overrides);
+  auto spec_threads = spec;
+  if (args.threads > 0) spec_threads.numerics.threads = args.threads;
+  fs::path out = args.out;
+  if (out.empty()) {
+    std::string id = spec.id;
+    std::replace(id.begin(), id.end(), '/', '_');
+    out = fs::path("results") / spec.fidelity / id;
+  }
+  const auto units = sim::derive_units(spec_threads);
+  print_units(spec_threads, units);
+  sim::ProgressFn progress = [&](long step, long total, double t, double mlups) {
+    const double eta = (total - step) * (units.node_updates / total) / (mlups * 1e6);
+    const std::string line =
+        fmt::format("step {}/{}  t = {:.2f} L/U  {:.1f} MLUPS  ETA {}", step, total, t, mlups, human_seconds(eta));
+    if (terminal)
+      fmt::print(stderr, "\r{:<78}", line);
+    else if (step % std::max(1L, total / 10) < std::max(1L, total / 200))
+      fmt::print(stderr, "{}\n", line);
+  };
+  const auto r = sim::run_case(spec_threads, out, progress);
+  if (terminal) fmt::print(stderr, "\n");
+  fmt::print("ran {} steps in {} ({:.1f} MLUPS) -> {}\n", r.steps, human_seconds(r.wall_seconds), r.mlups, out.string());
+  for (const auto& [k, v] : r.summary["metrics"].items())
+    fmt::print("  {:34s} {:.6g}\n", k, v["value"].get<double>());
+  return score(ScoreArgs{out, args.strict});
+}
+
+}  // namespace caplab::app

@@ -1,0 +1,37 @@
+// The subcommands of `caplab`; each returns the process exit code or throws a core error.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace caplab::app {
+
+struct RunArgs {
+  std::filesystem::path case_file, out;
+  std::string fidelity = "standard";
+  std::vector<std::string> overrides;
+  int threads = 0;
+  bool strict = false;
+};
+struct CheckArgs {
+  std::filesystem::path case_file;
+  std::string fidelity = "standard";
+  std::vector<std::string> overrides;
+};
+struct ScoreArgs {
+  std::filesystem::path run_dir;
+  bool strict = false;
+};
+struct BenchArgs {
+  std::filesystem::path out;
+  bool quick = false;
+};
+
+int run(const RunArgs& args, bool terminal);
+int check(const CheckArgs& args);
+int list(const std::filesystem::path& dir);
+int score(const ScoreArgs& args);
+int bench(const BenchArgs& args);
+
+}  // namespace caplab::app

@@ -1,0 +1,76 @@
+// The `caplab` command: run, check, list, score, bench.
+//
+// The only place that maps errors to exit codes (DESIGN.md section 6): 0 ran (and, with
+// --strict, passed), 1 scored outside tolerance, 2 bad input, 3 numerical instability,
+// 4 any other failure.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include <fmt/format.h>
+
+#include "app/commands.hpp"
+#include "core/build_info.hpp"
+#include "core/error.hpp"
+
+namespace fs = std::filesystem;
+using namespace caplab;
+
+int main(int argc, char** argv) {
+  CLI::App app{"caplab — immersed-boundary / multi-block lattice Boltzmann capsules in shear flow (Sui's thesis)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string(core::build_info().version) + " (" +
+                                        std::string(core::build_info().git_sha) + ")");
+
+  app::RunArgs run;
+  auto* run_cmd = app.add_subcommand("run", "Run a case and write its run directory (then score it)");
+  run_cmd->add_option("case", run.case_file, "Case file (JSON)")->required()->check(CLI::ExistingFile);
+  run_cmd->add_option("--fidelity", run.fidelity, "Fidelity level defined by the case: quick | standard | thesis")
+      ->default_val("standard");
+  run_cmd->add_option("--out", run.out, "Run directory (default results/<fidelity>/<case id>)");
+  run_cmd->add_option("--set", run.overrides, "Override a case value: path=value (repeatable), e.g. physics.reynolds=200");
+  run_cmd->add_option("--threads", run.threads, "OpenMP threads (0: all)")->default_val(0);
+  run_cmd->add_flag("--strict", run.strict, "Exit 1 when the score fails its tolerances");
+
+  app::CheckArgs check;
+  auto* check_cmd = app.add_subcommand("check", "Validate a case; print the derived lattice parameters and cost");
+  check_cmd->add_option("case", check.case_file, "Case file (JSON)")->required()->check(CLI::ExistingFile);
+  check_cmd->add_option("--fidelity", check.fidelity, "Fidelity level")->default_val("standard");
+  check_cmd->add_option("--set", check.overrides, "Override a case value: path=value (repeatable)");
+
+  std::string list_dir = "catalogue";
+  auto* list_cmd = app.add_subcommand("list", "List the cases of a catalogue directory");
+  list_cmd->add_option("dir", list_dir, "Directory to search (default: catalogue)");
+
+  app::ScoreArgs score;
+  auto* score_cmd = app.add_subcommand("score", "Score a finished run directory against its references");
+  score_cmd->add_option("run_dir", score.run_dir, "Run directory")->required()->check(CLI::ExistingDirectory);
+  score_cmd->add_flag("--strict", score.strict, "Exit 1 when sanity or accuracy fails");
+
+  app::BenchArgs bench;
+  auto* bench_cmd = app.add_subcommand("bench", "Measure memory bandwidth and fluid MLUPS (roofline)");
+  bench_cmd->add_option("--out", bench.out, "Output directory")->default_val("reports/out/bench");
+  bench_cmd->add_flag("--quick", bench.quick, "Small sizes and short timings (smoke test)");
+
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (*run_cmd) return app::run(run, isatty(fileno(stderr)));
+    if (*check_cmd) return app::check(check);
+    if (*list_cmd) return app::list(list_dir);
+    if (*score_cmd) return app::score(score);
+    if (*bench_cmd) return app::bench(bench);
+  } catch (const core::InputError& e) {
+    fmt::print(stderr, "caplab: input error: {}\n", e.what());
+    return 2;
+  } catch (const core::NumericalError& e) {
+    fmt::print(stderr, "caplab: {}\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "caplab: error: {}\n", e.what());
+    return 4;
+  }
+  return 4;
+}

@@ -1,0 +1,464 @@
+// The scene of a case: fluid blocks, rigid bodies with direct forcing, diagnostics, guards
+// and outputs, assembled once from the validated case (lifecycle: build → initialise → run
+// → summarise). Templated on lattice, precision and collision operator (per-node decisions);
+// everything decided per step (which bodies, which outputs) is run-time data.
+//
+// Order of one coarse step (thesis fig. 2.4): coarse collide-push and boundaries; then per
+// fine substep the IB stage (direct forcing on the finest block from its force-free
+// velocity) followed by the forced collide-push and the coupled ghost ring; restriction.
+// Forces on bodies: minus the force they spread (Newton's third law); fixed bodies need no
+// internal-mass correction.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <fmt/format.h>
+
+#include <numbers>
+#include <variant>
+
+#include "case/case_spec.hpp"
+#include "core/error.hpp"
+#include "diagnostics/signal.hpp"
+#include "geometry/marker_set.hpp"
+#include "ibm/direct_forcing.hpp"
+#include "io/run_directory.hpp"
+#include "io/series_writer.hpp"
+#include "io/snapshot_writer.hpp"
+#include "sim/fluid.hpp"
+#include "sim/units.hpp"
+
+namespace caplab::sim {
+
+/// Called about once a second: step, total steps, time (L/U), MLUPS so far.
+using ProgressFn = std::function<void(long, long, double, double)>;
+
+struct RunResult {
+  long steps = 0;
+  double wall_seconds = 0;
+  double mlups = 0;
+  nlohmann::json stage_seconds;
+  nlohmann::json summary;  ///< the content of summary.json
+};
+
+template <class L, class T, class Op>
+class Scene {
+ public:
+  static constexpr int D = L::d;
+  using FluidT = Fluid<L, T, Op>;
+  using Forcing = std::variant<ibm::DirectForcing<D, ibm::Cosine4>, ibm::DirectForcing<D, ibm::Roma3>,
+                               ibm::DirectForcing<D, ibm::Linear2>>;
+
+  Scene(const cases::CaseSpec& spec, const LatticeUnits& units, const Op& coarse_op)
+      : spec_(spec), units_(units), fluid_(make_setup(spec, units, coarse_op)) {
+    build_bodies();
+    build_series_columns();
+    fluid_.initialise([&](const Vec<D>& x) {
+      const auto u = imposed_velocity(spec_, std::vector<double>(x.data(), x.data() + D));
+      Vec<D> ulu;
+      for (int a = 0; a < D; ++a) ulu[a] = u[a] * units_.velocity_lu;
+      return std::pair{1.0, Vec<D>(ulu + initial_perturbation(x))};
+    });
+  }
+
+  RunResult run(io::RunDirectory& dir, const ProgressFn& progress) {
+    using clock = std::chrono::steady_clock;
+    const auto start = clock::now();
+    const double dt = units_.blocks[0].dt;
+    const long total = units_.coarse_steps;
+    const long sample_every = std::max(1L, std::lround(spec_.outputs.series.interval / dt));
+    const long guard_every = 100;
+    std::vector<long> snapshot_steps;
+    for (double ts : spec_.outputs.snapshots.times) snapshot_steps.push_back(std::lround(std::ceil(ts / dt - 1e-9)));
+
+    io::SeriesWriter series(dir.partial_path("series.h5"), columns_, {{"case_id", spec_.id}, {"fidelity", spec_.fidelity}});
+    std::optional<io::SnapshotWriter<D>> snapshots;
+    if (!snapshot_steps.empty())
+      snapshots.emplace(dir.partial_path("snapshots.h5"), dir.path("snapshots.xdmf"), "snapshots.h5",
+                        nlohmann::json{{"case_id", spec_.id}});
+
+    mass0_ = total_mass();
+    auto last_report = clock::now();
+    auto hook = [&](const typename FluidT::Pop& pop, typename FluidT::Force& f) { return apply_ib(pop, f); };
+    std::vector<double> row(columns_.size());
+    for (long step = 1; step <= total; ++step) {
+      timed(seconds_fluid_, [&] { fluid_.step(hook); });
+      const double t = step * dt;
+      if (step % guard_every == 0 || step == total) timed(seconds_diagnostics_, [&] { check_guards(step); });
+      if (step % sample_every == 0 || step == total) {
+        timed(seconds_diagnostics_, [&] { sample(t, row); });
+        timed(seconds_output_, [&] { series.append(row); });
+      }
+      if (snapshots && std::find(snapshot_steps.begin(), snapshot_steps.end(), step) != snapshot_steps.end())
+        timed(seconds_output_, [&] { write_snapshot(*snapshots, t); });
+      if (progress && clock::now() - last_report > std::chrono::seconds(1)) {
+        const double wall = std::chrono::duration<double>(clock::now() - start).count();
+        progress(step, total, t, fluid_.updates_per_step() * step / wall / 1e6);
+        last_report = clock::now();
+      }
+    }
+    series.close();
+    dir.commit_file("series.h5");
+    if (snapshots) {
+      snapshots->close();
+      dir.commit_file("snapshots.h5");
+    }
+
+    RunResult r;
+    r.steps = total;
+    r.wall_seconds = std::chrono::duration<double>(clock::now() - start).count();
+    r.mlups = fluid_.updates_per_step() * total / r.wall_seconds / 1e6;
+    const double coupling = fluid_.coupling_seconds();
+    // The IB hook runs inside the fluid step: report it apart from the fluid update.
+    r.stage_seconds = {{"fluid", seconds_fluid_ - coupling - seconds_ib_},
+                       {"coupling", coupling},
+                       {"ib", seconds_ib_},
+                       {"membrane", 0.0},
+                       {"diagnostics", seconds_diagnostics_},
+                       {"output", seconds_output_}};
+    r.summary = summarise(dir);
+    return r;
+  }
+
+ private:
+  struct RigidBody {
+    std::string name;
+    cases::ShapeSpec shape;
+    geometry::MarkerSet<D> markers;
+    std::vector<double> weight_lu;
+    std::vector<Vec<D>> desired_lu;
+    Forcing forcing;
+    Vec<D> force_on_body_lu = Vec<D>::Zero();
+    double coefficient_scale = 1.0;  // 1 / (½ ρ U_lu² A_lu)
+  };
+
+  static typename FluidT::Setup make_setup(const cases::CaseSpec& spec, const LatticeUnits& units, const Op& op) {
+    typename FluidT::Setup s;
+    auto grid_of = [](const BlockUnits& b) {
+      Index<D> n;
+      Vec<D> o;
+      for (int a = 0; a < D; ++a) n[a] = b.nodes[a], o[a] = b.origin[a];
+      return field::Grid<D>(n, o, b.dx);
+    };
+    s.coarse = grid_of(units.blocks[0]);
+    if (units.blocks.size() == 2) s.fine = grid_of(units.blocks[1]);
+    for (int a = 0; a < D; ++a) {
+      switch (spec.physics.boundaries[a]) {
+        case cases::BoundaryType::periodic: s.boundaries[a] = boundary::Kind::periodic; break;
+        case cases::BoundaryType::far_field: s.boundaries[a] = boundary::Kind::far_field; break;
+        case cases::BoundaryType::wall: s.boundaries[a] = boundary::Kind::wall; break;
+      }
+    }
+    const double ulu = units.velocity_lu;
+    s.imposed_velocity_lu = [spec, ulu](const Vec<D>& x) {
+      const auto u = imposed_velocity(spec, std::vector<double>(x.data(), x.data() + D));
+      Vec<D> v;
+      for (int a = 0; a < D; ++a) v[a] = u[a] * ulu;
+      return v;
+    };
+    s.coarse_op = op;
+    if (spec.physics.flow.type == cases::FlowSpec::Type::body_force)
+      s.body_force_lu[0] = spec.physics.flow.body_force * ulu * ulu * units.blocks[0].dx;
+    s.finest_forced = !spec.physics.bodies.empty();
+    return s;
+  }
+
+  void build_bodies() {
+    const auto& fine = fluid_.finest().pop.grid();
+    const double h = fine.dx();
+    const double spacing = spec_.numerics.ib.marker_spacing * h;
+    for (const auto& b : spec_.physics.bodies) {
+      RigidBody body{b.name, b.shape, {}, {}, {}, make_forcing(), Vec<D>::Zero(), 1.0};
+      Vec<D> c;
+      for (int a = 0; a < D; ++a) c[a] = b.shape.center[a];
+      if constexpr (D == 2) {
+        body.markers = geometry::circle_markers(c, b.shape.diameter, spacing);
+        body.coefficient_scale = 1.0 / (0.5 * units_.velocity_lu * units_.velocity_lu * (b.shape.diameter / h));
+      } else {
+        body.markers = geometry::sphere_markers(c, b.shape.diameter, spacing);
+        const double r = 0.5 * b.shape.diameter / h;
+        body.coefficient_scale = 1.0 / (0.5 * units_.velocity_lu * units_.velocity_lu * std::numbers::pi * r * r);
+      }
+      for (double w : body.markers.weight) body.weight_lu.push_back(ibm::measure_to_lattice<D>(w, h));
+      body.desired_lu.assign(body.markers.X.size(), Vec<D>::Zero());  // fixed bodies
+      bodies_.push_back(std::move(body));
+    }
+    if (fluid_.two_level()) {
+      periodic_.fill(false);
+    } else {
+      for (int a = 0; a < D; ++a) periodic_[a] = spec_.physics.boundaries[a] == cases::BoundaryType::periodic;
+    }
+  }
+
+  /// Transverse velocity blob (lattice units) 1.5 D downstream of each body, width D/2
+  /// (physics.flow.perturbation; see case_spec.hpp).
+  Vec<D> initial_perturbation(const Vec<D>& x) const {
+    Vec<D> du = Vec<D>::Zero();
+    const double amp = spec_.physics.flow.perturbation;
+    if (amp == 0.0) return du;
+    const auto& dir = spec_.physics.flow.direction;
+    for (const auto& b : spec_.physics.bodies) {
+      Vec<D> c;
+      for (int a = 0; a < D; ++a) c[a] = b.shape.center[a] + 1.5 * b.shape.diameter * dir[a];
+      const double w = 0.5 * b.shape.diameter;
+      const double g = std::exp(-(x - c).squaredNorm() / (2 * w * w));
+      du[0] += -amp * dir[1] * g * units_.velocity_lu;
+      du[1] += amp * dir[0] * g * units_.velocity_lu;
+    }
+    return du;
+  }
+
+  Forcing make_forcing() const {
+    const int it = spec_.numerics.ib.forcing_iterations;
+    switch (spec_.numerics.ib.kernel) {
+      case cases::IbSpec::Kernel::roma3: return ibm::DirectForcing<D, ibm::Roma3>(it);
+      case cases::IbSpec::Kernel::linear2: return ibm::DirectForcing<D, ibm::Linear2>(it);
+      default: return ibm::DirectForcing<D, ibm::Cosine4>(it);
+    }
+  }
+
+  /// The IB stage of one finest-block step: adds the bodies' force density to f.
+  bool apply_ib(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
+    if (bodies_.empty()) return false;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto u_star = [&](const Index<D>&, std::ptrdiff_t n) {
+      const auto m = collision::node_moments<L, T>(pop, n);
+      Vec<D> u;
+      for (int a = 0; a < D; ++a) u[a] = m.u[a];
+      return u;
+    };
+    auto rho = [&](const Index<D>&, std::ptrdiff_t n) { return collision::node_moments<L, T>(pop, n).rho; };
+    for (auto& b : bodies_) {
+      std::visit(
+          [&](auto& forcing) {
+            forcing.apply(pop.grid(), periodic_, b.markers.X, b.desired_lu, b.weight_lu, u_star, rho, f);
+            b.force_on_body_lu = -forcing.total_force_on_fluid();
+          },
+          b.forcing);
+    }
+    seconds_ib_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return true;
+  }
+
+  /// Drag along the flow direction, lift perpendicular to it (in the x–y plane).
+  std::pair<double, double> coefficients(const RigidBody& b) const {
+    Vec<D> e_drag = Vec<D>::Zero();
+    e_drag[0] = 1.0;
+    if (spec_.physics.flow.type == cases::FlowSpec::Type::uniform && !spec_.physics.flow.direction.empty())
+      for (int a = 0; a < D; ++a) e_drag[a] = spec_.physics.flow.direction[a];
+    Vec<D> e_lift = Vec<D>::Zero();
+    e_lift[0] = -e_drag[1];
+    e_lift[1] = e_drag[0];
+    return {b.force_on_body_lu.dot(e_drag) * b.coefficient_scale, b.force_on_body_lu.dot(e_lift) * b.coefficient_scale};
+  }
+
+  void build_series_columns() {
+    columns_.push_back({"t", "L/U", "time in units of the reference length over the reference velocity"});
+    const bool many = bodies_.size() > 1;
+    for (const auto& q : spec_.outputs.series.quantities) {
+      if (q == "drag_coefficient" || q == "lift_coefficient") {
+        if (bodies_.empty())
+          throw core::InputError(spec_.source_file, "/outputs/series/quantities", q, "a quantity of a scene with bodies (this case has none)");
+        for (const auto& b : bodies_)
+          columns_.push_back({many ? b.name + "." + q : q, "1",
+                              q == "drag_coefficient" ? "C_d = F_drag / (0.5 rho U^2 D) (per unit span in 2D; area pi D^2/4 in 3D)"
+                                                      : "C_l = F_lift / (0.5 rho U^2 D) (per unit span in 2D; area pi D^2/4 in 3D)"});
+      } else if (q == "mass") {
+        columns_.push_back({"mass", "1", "total fluid mass over its initial value"});
+      } else if (q == "kinetic_energy") {
+        columns_.push_back({"kinetic_energy", "rho U^2 L^D", "integral of rho u^2 / 2 over the domain"});
+      } else {
+        throw core::InputError(spec_.source_file, "/outputs/series/quantities", q,
+                               "one of drag_coefficient, lift_coefficient, mass, kinetic_energy");
+      }
+    }
+  }
+
+  void sample(double t, std::vector<double>& row) {
+    std::size_t k = 0;
+    row[k++] = t;
+    for (const auto& q : spec_.outputs.series.quantities) {
+      if (q == "drag_coefficient" || q == "lift_coefficient") {
+        for (const auto& b : bodies_) {
+          const auto [cd, cl] = coefficients(b);
+          row[k++] = q == "drag_coefficient" ? cd : cl;
+        }
+      } else if (q == "mass") {
+        row[k++] = total_mass() / mass0_;
+      } else if (q == "kinetic_energy") {
+        row[k++] = integrate([](double rho, const Vec<D>& u) { return 0.5 * rho * u.squaredNorm(); }) /
+                   (units_.velocity_lu * units_.velocity_lu);
+      }
+    }
+  }
+
+  /// ∫ g(ρ, u_lu) dV over the domain (in L^D), fine block where it exists.
+  template <class G>
+  double integrate(G&& g) const {
+    double sum = 0;
+    for (std::size_t b = 0; b < fluid_.block_count(); ++b) {
+      const auto& blk = fluid_.block(b);
+      const auto& grid = blk.pop.grid();
+      const double vol = std::pow(grid.dx(), D);
+      double s = 0;
+      field::for_each_interior<D>(grid, [&](const Index<D>& ijk) {
+        if (b == 0 && fluid_.two_level() && fluid_.coupling().covered(ijk)) return;
+        const auto m = collision::node_moments<L, T>(blk.pop, grid.index(ijk));
+        Vec<D> u;
+        for (int a = 0; a < D; ++a) u[a] = m.u[a];
+        s += g(m.rho, u);
+      });
+      sum += s * vol;
+    }
+    return sum;
+  }
+
+  double total_mass() const {
+    return integrate([](double rho, const Vec<D>&) { return rho; });
+  }
+
+  /// Stops the run with the step, the place and the likely cause when the flow has left
+  /// the range where the method is valid (non-finite, Mach, density).
+  void check_guards(long step) const {
+    for (std::size_t b = 0; b < fluid_.block_count(); ++b) {
+      const auto& blk = fluid_.block(b);
+      const auto& grid = blk.pop.grid();
+      std::string problem;
+      Index<D> where{};
+      field::for_each_interior<D>(grid, [&](const Index<D>& ijk) {
+        if (!problem.empty()) return;
+        const auto m = collision::node_moments<L, T>(blk.pop, grid.index(ijk));
+        double u2 = 0;
+        for (int a = 0; a < D; ++a) u2 += m.u[a] * m.u[a];
+        if (!std::isfinite(m.rho) || !std::isfinite(u2))
+          problem = "non-finite density or velocity";
+        else if (std::sqrt(3.0 * u2) > 1.0)
+          problem = fmt::format("local Mach number {:.2f} above 1", std::sqrt(3.0 * u2));
+        else if (std::abs(m.rho - 1.0) > 0.3)
+          problem = fmt::format("density {:.3f} deviates by more than 30 % from 1", m.rho);
+        if (!problem.empty()) where = ijk;
+      });
+      if (!problem.empty()) {
+        const Vec<D> x = grid.position(where);
+        std::string pos = fmt::format("{:.4g}", x[0]);
+        for (int a = 1; a < D; ++a) pos += fmt::format(", {:.4g}", x[a]);
+        throw core::NumericalError(
+            step, fmt::format("{} block, node at ({}) L", units_.blocks[b].name, pos), problem,
+            fmt::format("tau = {:.4f} on this block is close to 1/2 or the lattice velocity {:.3g} is too high for "
+                        "this Reynolds number; use the TRT operator, refine the grid or lower numerics.lattice_velocity",
+                        units_.blocks[b].tau, units_.velocity_lu));
+      }
+    }
+  }
+
+  void write_snapshot(io::SnapshotWriter<D>& w, double t) const {
+    for (std::size_t b = 0; b < fluid_.block_count(); ++b) {
+      const auto& blk = fluid_.block(b);
+      const auto& grid = blk.pop.grid();
+      const std::ptrdiff_t N = grid.size();
+      std::vector<double> rho(N, 1.0);
+      std::array<std::vector<double>, D> u;
+      for (auto& c : u) c.assign(N, 0.0);
+      field::for_each_interior<D>(grid, [&](const Index<D>& ijk) {
+        const auto n = grid.index(ijk);
+        const auto m = collision::node_moments<L, T>(blk.pop, n);
+        rho[n] = m.rho;
+        for (int a = 0; a < D; ++a) u[a][n] = m.u[a] / units_.velocity_lu;  // in U
+      });
+      typename io::SnapshotWriter<D>::ScalarFields scalars;
+      typename io::SnapshotWriter<D>::GridVectorFields vectors;
+      std::vector<double> vort;
+      std::array<std::vector<double>, 3> vort3;
+      const auto& fields = spec_.outputs.snapshots.fields;
+      auto wants = [&](const char* f) { return std::find(fields.begin(), fields.end(), f) != fields.end(); };
+      if (wants("density")) scalars["density"] = rho;
+      if (wants("velocity")) {
+        std::array<std::span<const double>, D> spans;
+        for (int a = 0; a < D; ++a) spans[a] = u[a];
+        vectors["velocity"] = spans;
+      }
+      if (wants("vorticity")) {
+        // Central differences in the interior, one-sided next to the ghost layer; in U/L.
+        auto d = [&](int comp, int axis, const Index<D>& ijk) {
+          Index<D> lo = ijk, hi = ijk;
+          lo[axis] = std::max(ijk[axis] - 1, 0);
+          hi[axis] = std::min(ijk[axis] + 1, grid.n()[axis] - 1);
+          return (u[comp][grid.index(hi)] - u[comp][grid.index(lo)]) / ((hi[axis] - lo[axis]) * grid.dx());
+        };
+        if constexpr (D == 2) {
+          vort.assign(N, 0.0);
+          field::for_each_interior<2>(grid, [&](const Index<2>& ijk) { vort[grid.index(ijk)] = d(1, 0, ijk) - d(0, 1, ijk); });
+          scalars["vorticity"] = vort;
+        } else {
+          for (auto& c : vort3) c.assign(N, 0.0);
+          field::for_each_interior<3>(grid, [&](const Index<3>& ijk) {
+            const auto n = grid.index(ijk);
+            vort3[0][n] = d(2, 1, ijk) - d(1, 2, ijk);
+            vort3[1][n] = d(0, 2, ijk) - d(2, 0, ijk);
+            vort3[2][n] = d(1, 0, ijk) - d(0, 1, ijk);
+          });
+          vectors["vorticity"] = {std::span<const double>(vort3[0]), std::span<const double>(vort3[1]),
+                                  std::span<const double>(vort3[2])};
+        }
+      }
+      w.add_grid_field_step(t, grid, units_.blocks[b].name, scalars, vectors);
+    }
+    if constexpr (D == 2) {
+      for (const auto& b : bodies_) {
+        const auto segs = io::closed_ring_segments(static_cast<int>(b.markers.X.size()));
+        w.add_mesh_step(t, b.name, b.markers.X, segs);
+      }
+    }
+  }
+
+  nlohmann::json summarise(const io::RunDirectory& dir) const {
+    nlohmann::json metrics = nlohmann::json::object();
+    const auto series = io::read_series(dir.path("series.h5"));
+    const auto& tt = series.at("t");
+    const double from = spec_.outputs.average_from;
+    for (const auto& col : columns_) {
+      if (col.name == "t") continue;
+      const auto& v = series.at(col.name);
+      metrics[col.name + "_final"] = {{"value", v.back()}, {"unit", col.unit}, {"definition", "value at the end of the run: " + col.definition}};
+      const bool coefficient = col.name.ends_with("drag_coefficient") || col.name.ends_with("lift_coefficient");
+      if (!coefficient) continue;
+      const auto s = diagnostics::analyse_signal(tt, v, from);
+      const std::string window = fmt::format(" over t >= {} L/U", from);
+      metrics[col.name + "_mean"] = {{"value", s.mean}, {"unit", "1"}, {"definition", "time average" + window}};
+      metrics[col.name + "_amplitude"] = {{"value", s.amplitude}, {"unit", "1"}, {"definition", "(max - min)/2" + window}};
+      // A Strouhal number only from a real oscillation (|C_l| amplitude above 1e-3), never
+      // from round-off: without shedding the metric is absent and its acceptance fails.
+      if (col.name.ends_with("lift_coefficient") && s.frequency && s.amplitude > 1e-3) {
+        const std::string prefix = col.name.substr(0, col.name.size() - std::string("lift_coefficient").size());
+        double diameter = 1.0;
+        for (const auto& b : bodies_)
+          if (prefix.empty() || prefix == b.name + ".") diameter = b.shape.diameter;
+        metrics[prefix + "strouhal_number"] = {
+            {"value", *s.frequency * diameter},
+            {"unit", "1"},
+            {"definition", fmt::format("St = f D / U, f from {} periods of the lift signal", s.periods) + window}};
+      }
+    }
+    nlohmann::json sanity = {{"finite", true}};
+    if (series.count("mass")) sanity["mass_drift"] = std::abs(series.at("mass").back() - 1.0);
+    return {{"case_id", spec_.id}, {"fidelity", spec_.fidelity}, {"metrics", metrics}, {"sanity", sanity}};
+  }
+
+  template <class F>
+  static void timed(double& acc, F&& f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    acc += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  const cases::CaseSpec& spec_;
+  LatticeUnits units_;
+  FluidT fluid_;
+  std::vector<RigidBody> bodies_;
+  std::array<bool, D> periodic_{};
+  std::vector<io::SeriesColumn> columns_;
+  double mass0_ = 1.0;
+  double seconds_fluid_ = 0, seconds_ib_ = 0, seconds_diagnostics_ = 0, seconds_output_ = 0;
+};
+
+}  // namespace caplab::sim

@@ -1,0 +1,153 @@
+#include "sim/units.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace caplab::sim {
+
+using cases::BoundaryType;
+using cases::CaseSpec;
+using cases::FlowSpec;
+using cases::GridSpec;
+
+double BlockUnits::node_count() const {
+  double n = 1;
+  for (int k : nodes) n *= k;
+  return n;
+}
+
+namespace {
+
+/// Interior nodes and origin of the coarsest grid along one axis of length `len`.
+/// Far field: nodes on both faces; periodic: one face; wall: half a spacing inside each wall.
+void place_axis(BoundaryType b, double len, double h, int& n, double& origin) {
+  const int cells = static_cast<int>(std::lround(len / h));
+  switch (b) {
+    case BoundaryType::far_field: n = cells + 1, origin = 0.0; break;
+    case BoundaryType::periodic: n = cells, origin = 0.0; break;
+    case BoundaryType::wall: n = cells, origin = 0.5 * h; break;
+  }
+}
+
+double reynolds_factor(const CaseSpec& spec, std::string& definition) {
+  if (spec.physics.flow.type == FlowSpec::Type::shear && spec.physics.dimension == 2) {
+    definition = "Re = rho (2 k a)(2 a) / mu (thesis chapters 2-4)";
+    return 4.0;
+  }
+  if (spec.physics.flow.type == FlowSpec::Type::shear) {
+    definition = "Re = rho k a^2 / mu (thesis chapters 5-6)";
+    return 1.0;
+  }
+  definition = "Re = rho U L / mu";
+  return 1.0;
+}
+
+}  // namespace
+
+std::vector<double> imposed_velocity(const CaseSpec& spec, const std::vector<double>& x) {
+  const int D = spec.physics.dimension;
+  std::vector<double> u(D, 0.0);
+  switch (spec.physics.flow.type) {
+    case FlowSpec::Type::uniform:
+      for (int a = 0; a < D; ++a) u[a] = spec.physics.flow.direction.empty() ? (a == 0) : spec.physics.flow.direction[a];
+      break;
+    case FlowSpec::Type::shear: {
+      const int g = D - 1;  // 2D: u = (k y, 0); 3D: u = (k z, 0, 0), centred in the domain
+      u[0] = x[g] - 0.5 * spec.physics.domain_size[g];
+      break;
+    }
+    default: break;
+  }
+  return u;
+}
+
+LatticeUnits derive_units(const CaseSpec& spec) {
+  const int D = spec.physics.dimension;
+  const auto& grid = spec.numerics.grid;
+  LatticeUnits lu;
+  lu.velocity_lu = spec.numerics.lattice_velocity;
+  lu.viscosity = reynolds_factor(spec, lu.reynolds_definition) / spec.physics.reynolds;
+  const bool two_level = grid.refinement == GridSpec::Refinement::two_level;
+  const double h_c = two_level ? 2.0 * grid.fine_spacing : grid.fine_spacing;
+
+  auto make_block = [&](const std::string& name, double h) {
+    BlockUnits b;
+    b.name = name;
+    b.dx = h;
+    b.dt = lu.velocity_lu * h;
+    b.nu_lu = lu.viscosity * lu.velocity_lu / h;
+    b.tau = 0.5 + 3.0 * b.nu_lu;
+    return b;
+  };
+  BlockUnits coarse = make_block(two_level ? "coarse" : "uniform", h_c);
+  coarse.nodes.resize(D);
+  coarse.origin.resize(D);
+  for (int a = 0; a < D; ++a)
+    place_axis(spec.physics.boundaries[a], spec.physics.domain_size[a], h_c, coarse.nodes[a], coarse.origin[a]);
+  lu.blocks.push_back(coarse);
+  if (two_level) {
+    BlockUnits fine = make_block("fine", grid.fine_spacing);
+    fine.nodes.resize(D);
+    fine.origin.resize(D);
+    for (int a = 0; a < D; ++a) {
+      // The ghost ring (thesis line MN) sits on the coarse nodes nearest the requested faces.
+      const long lo = std::lround((grid.fine_min[a] - coarse.origin[a]) / h_c);
+      const long hi = std::lround((grid.fine_max[a] - coarse.origin[a]) / h_c);
+      fine.nodes[a] = static_cast<int>(2 * (hi - lo) - 1);
+      fine.origin[a] = coarse.origin[a] + lo * h_c + grid.fine_spacing;
+    }
+    lu.blocks.push_back(fine);
+  }
+  for (const auto& b : lu.blocks)
+    if (b.tau <= 0.5 + 1e-9)
+      throw core::InputError(spec.source_file, "/physics/reynolds", fmt::format("{}", spec.physics.reynolds),
+                             fmt::format("a Reynolds number giving tau > 0.5 on block {} (got tau = {:.6f})", b.name, b.tau));
+
+  // Largest imposed speed: uniform flow 1, shear k·(half height), else 1 (a scale).
+  double umax = 1.0;
+  if (spec.physics.flow.type == FlowSpec::Type::shear) umax = 0.5 * spec.physics.domain_size[D - 1];
+  lu.mach = umax * lu.velocity_lu * std::sqrt(3.0);
+  if (lu.mach > 0.7)
+    throw core::InputError(spec.source_file, "/numerics/lattice_velocity", fmt::format("{}", lu.velocity_lu),
+                           fmt::format("a lattice velocity giving a Mach number below 0.7 (largest imposed "
+                                       "speed is {:.3g} U, Mach {:.3f}); lower lattice_velocity",
+                                       umax, lu.mach));
+
+  lu.coarse_steps = static_cast<long>(std::ceil(spec.numerics.end_time / lu.blocks[0].dt - 1e-9));
+  double per_step = lu.blocks[0].node_count();
+  if (two_level) per_step += 2.0 * lu.blocks[1].node_count();
+  lu.node_updates = per_step * static_cast<double>(lu.coarse_steps);
+  const double bytes_per_value = spec.numerics.precision == cases::Precision::single ? 4.0 : 8.0;
+  const int q = D == 2 ? 9 : 19;
+  for (const auto& b : lu.blocks) {
+    double with_ghosts = 1;
+    for (int k : b.nodes) with_ghosts *= k + 2;
+    lu.memory_bytes += with_ghosts * (2.0 * q * bytes_per_value + D * 8.0);
+  }
+  return lu;
+}
+
+nlohmann::json LatticeUnits::to_json() const {
+  nlohmann::json j;
+  j["velocity_lu"] = velocity_lu;
+  j["mach"] = mach;
+  j["viscosity"] = {{"value", viscosity}, {"unit", "U L"}};
+  j["reynolds_definition"] = reynolds_definition;
+  j["coarse_steps"] = coarse_steps;
+  j["node_updates"] = node_updates;
+  j["memory_bytes"] = memory_bytes;
+  for (const auto& b : blocks)
+    j["blocks"].push_back({{"name", b.name},
+                           {"dx", b.dx},
+                           {"dt", b.dt},
+                           {"tau", b.tau},
+                           {"nu_lu", b.nu_lu},
+                           {"nodes", b.nodes},
+                           {"origin", b.origin}});
+  return j;
+}
+
+}  // namespace caplab::sim

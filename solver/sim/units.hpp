@@ -1,0 +1,50 @@
+// Lattice parameters derived from a case: the one place where physical (thesis) units meet
+// lattice units.
+//
+// Units of a case: lengths in L (D or a), velocities in U (U∞ or k·a), time in L/U. With the
+// characteristic velocity U_lu in lattice units (the same on every block: acoustic scaling,
+// Δt ∝ Δx) a block of spacing h (in L) has Δt = U_lu·h (in L/U), and the viscosity
+// ν = factor/Re (in U·L; factor 4 for the 2D shear-flow Reynolds number ρ(2ka)(2a)/μ, else 1)
+// becomes ν_lu = ν·U_lu/h, τ = ½ + ν_lu/cs² (thesis eq. 2.6), τ_f = ½ + m(τ_c − ½) (eq. 2.10).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "case/case_spec.hpp"
+
+namespace caplab::sim {
+
+struct BlockUnits {
+  std::string name;          ///< "coarse", "fine" or "uniform"
+  double dx = 0;             ///< spacing, in L
+  double dt = 0;             ///< time step, in L/U
+  double tau = 0;            ///< relaxation time
+  double nu_lu = 0;          ///< kinematic viscosity, lattice units
+  std::vector<int> nodes;    ///< interior nodes per axis
+  std::vector<double> origin;  ///< position of node 0, in L
+  double node_count() const;
+};
+
+struct LatticeUnits {
+  double velocity_lu = 0;       ///< U in lattice units
+  double mach = 0;              ///< largest imposed speed / cs
+  double viscosity = 0;         ///< ν in U·L
+  std::string reynolds_definition;
+  std::vector<BlockUnits> blocks;  ///< coarse first; one entry for a uniform grid
+  long coarse_steps = 0;        ///< steps of the coarsest block to reach end_time
+  double node_updates = 0;      ///< total node updates of the run
+  double memory_bytes = 0;      ///< populations (two buffers) plus force fields
+  double estimated_seconds(double mlups) const { return node_updates / (mlups * 1e6); }
+  nlohmann::json to_json() const;
+};
+
+/// Derives the lattice parameters of a validated case. Throws core::InputError for
+/// combinations that are valid JSON but not a usable lattice (τ ≤ ½, Mach too high).
+LatticeUnits derive_units(const cases::CaseSpec& spec);
+
+/// Imposed (unperturbed) velocity of the case's flow at position x (in L), in units of U.
+std::vector<double> imposed_velocity(const cases::CaseSpec& spec, const std::vector<double>& x);
+
+}  // namespace caplab::sim

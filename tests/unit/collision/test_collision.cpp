@@ -1,0 +1,490 @@
+// Unit tests of the collision/field layer (D2Q9 and D3Q19, float and double storage).
+//
+// Pointwise identities of one node (shifted populations, f_i − w_i; see field/populations.hpp):
+//  1. equilibrium moments: Σ feq = δρ, Σ c feq = ρu, Σ c c feq = ρ(uu + cs² I) − cs² I
+//     (the shift removes Σ w = 1 and Σ w c c = cs² I);
+//  2. Guo source moments: Σ S = 0, Σ c S = F, Σ c c S = uF + Fu;
+//  3. BGK and TRT conserve mass and momentum; with Guo forcing the post-collision momentum is
+//     the pre-collision momentum Σ c f plus exactly F; TRT with τ− = τ is BGK.
+// Whole-block behaviour:
+//  4. streaming with a null collision on a periodic block is the exact permutation
+//     f_i(x) ← f_i(x − c_i) with wrap-around (bitwise);
+//  5. a periodic Fluid conserves mass and momentum; a body force adds N·F per step;
+//  6. half-way bounce-back walls at rest keep the mass of a closed box;
+//  7. far field (non-equilibrium extrapolation) on all faces keeps a uniform flow uniform.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "boundary/boundary_set.hpp"
+#include "collision/equilibrium.hpp"
+#include "collision/operators.hpp"
+#include "collision/stream_collide.hpp"
+#include "field/grid.hpp"
+#include "field/populations.hpp"
+#include "lattice/lattice.hpp"
+#include "sim/fluid.hpp"
+
+namespace caplab::collision {
+namespace {
+
+using boundary::Kind;
+using lattice::D2Q9;
+using lattice::D3Q19;
+
+// ---------------------------------------------------------------------------------------
+// Type lists and small helpers
+
+template <class Lat, class Real>
+struct Config {
+  using L = Lat;
+  using T = Real;
+};
+using AllConfigs =
+    ::testing::Types<Config<D2Q9, double>, Config<D2Q9, float>, Config<D3Q19, double>, Config<D3Q19, float>>;
+using Lattices = ::testing::Types<D2Q9, D3Q19>;
+
+struct ConfigNames {
+  template <class C>
+  static std::string GetName(int) {
+    return std::string(C::L::name) + (std::is_same_v<typename C::T, float> ? "_float" : "_double");
+  }
+};
+struct LatticeNames {
+  template <class L>
+  static std::string GetName(int) {
+    return L::name;
+  }
+};
+
+/// Round-off tolerance of O(1) pointwise sums in storage precision T.
+template <class T>
+constexpr double tol = std::is_same_v<T, float> ? 2e-6 : 1e-14;
+
+double uniform(std::mt19937& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+
+/// Zeroth, first and second moments of a population vector, accumulated in double.
+template <class L>
+struct Sums {
+  double m0 = 0;
+  std::array<double, L::d> m1{};
+  std::array<std::array<double, L::d>, L::d> m2{};
+};
+
+template <class L, class T>
+Sums<L> sums(const T (&f)[L::q]) {
+  Sums<L> s;
+  for (int i = 0; i < L::q; ++i) {
+    s.m0 += f[i];
+    for (int a = 0; a < L::d; ++a) {
+      s.m1[a] += L::c[i][a] * double(f[i]);
+      for (int b = 0; b < L::d; ++b) s.m2[a][b] += L::c[i][a] * L::c[i][b] * double(f[i]);
+    }
+  }
+  return s;
+}
+
+template <class L, class T>
+std::array<T, L::d> random_vector(std::mt19937& rng, double amplitude) {
+  std::array<T, L::d> v;
+  for (int a = 0; a < L::d; ++a) v[a] = T(uniform(rng, -amplitude, amplitude));
+  return v;
+}
+
+/// Arbitrary (non-equilibrium) shifted pre-collision populations, ρ within about 1 ± 0.2.
+template <class L, class T>
+void random_populations(std::mt19937& rng, T (&f)[L::q]) {
+  for (int i = 0; i < L::q; ++i) f[i] = T(L::w[i] * uniform(rng, -0.2, 0.2));
+}
+
+/// One node through the operator as stream_collide does it (Guo forcing when F is non-null).
+template <class L, class T, class Op>
+void collide_node(const Op& op, const T (&f)[L::q], const T* F, T (&out)[L::q]) {
+  T feq[L::q];
+  const auto m = moments<L, T>(f, F);
+  equilibrium<L, T>(m.rho, m.u, feq);
+  if (F) {
+    T s[L::q];
+    guo_source<L, T>(m.u, F, s);
+    op.template collide<L, T>(f, feq, s, out);
+  } else {
+    op.template collide<L, T>(f, feq, nullptr, out);
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// 1–3: pointwise identities
+
+template <class C>
+class PointwiseTest : public ::testing::Test {};
+TYPED_TEST_SUITE(PointwiseTest, AllConfigs, ConfigNames);
+
+TYPED_TEST(PointwiseTest, EquilibriumMomentsAreShiftedMaxwellMoments) {
+  using L = typename TypeParam::L;
+  using T = typename TypeParam::T;
+  constexpr double cs2 = L::cs2;
+  std::mt19937 rng(11);
+  for (int sample = 0; sample < 200; ++sample) {
+    const T rho = T(uniform(rng, 0.8, 1.2));
+    const auto u = random_vector<L, T>(rng, 0.15);
+    T feq[L::q];
+    equilibrium<L, T>(rho, u, feq);
+    const auto s = sums<L>(feq);
+    const double r = rho;
+    EXPECT_NEAR(s.m0, r - 1.0, tol<T>) << sample;
+    for (int a = 0; a < L::d; ++a) {
+      EXPECT_NEAR(s.m1[a], r * u[a], tol<T>) << sample << " a=" << a;
+      for (int b = 0; b < L::d; ++b) {
+        // ρ(u_a u_b + cs² δ_ab) − cs² δ_ab: the shift removes Σ w c c = cs² I.
+        const double expected = r * u[a] * u[b] + (a == b ? (r - 1.0) * cs2 : 0.0);
+        EXPECT_NEAR(s.m2[a][b], expected, tol<T>) << sample << " ab=" << a << b;
+      }
+    }
+  }
+}
+
+TYPED_TEST(PointwiseTest, GuoSourceMoments) {
+  using L = typename TypeParam::L;
+  using T = typename TypeParam::T;
+  std::mt19937 rng(12);
+  for (int sample = 0; sample < 200; ++sample) {
+    const auto u = random_vector<L, T>(rng, 0.15);
+    const auto F = random_vector<L, T>(rng, 0.05);
+    T s[L::q];
+    guo_source<L, T>(u, F.data(), s);
+    const auto m = sums<L>(s);
+    EXPECT_NEAR(m.m0, 0.0, tol<T>) << sample;
+    for (int a = 0; a < L::d; ++a) {
+      EXPECT_NEAR(m.m1[a], F[a], tol<T>) << sample << " a=" << a;
+      for (int b = 0; b < L::d; ++b)
+        EXPECT_NEAR(m.m2[a][b], double(u[a]) * F[b] + double(F[a]) * u[b], tol<T>) << sample << " ab=" << a << b;
+    }
+  }
+}
+
+/// Checks mass and momentum of one collision: unforced unchanged, forced momentum + F.
+template <class L, class T, class Op>
+void check_collision_conservation(const Op& op, unsigned seed) {
+  std::mt19937 rng(seed);
+  for (int sample = 0; sample < 100; ++sample) {
+    T f[L::q], out[L::q];
+    random_populations<L, T>(rng, f);
+    const auto pre = sums<L>(f);
+
+    collide_node<L, T>(op, f, nullptr, out);
+    auto post = sums<L>(out);
+    double change = 0;
+    for (int i = 0; i < L::q; ++i) change += std::abs(double(out[i]) - f[i]);
+    ASSERT_GT(change, 1e-3) << "collision should change the populations";
+    EXPECT_NEAR(post.m0, pre.m0, tol<T>) << op.name << " unforced, sample " << sample;
+    for (int a = 0; a < L::d; ++a) EXPECT_NEAR(post.m1[a], pre.m1[a], tol<T>) << op.name << " unforced, a=" << a;
+
+    // Guo forcing: u = (Σ c f + F/2)/ρ in the equilibrium, S weighted by (1 − ω/2) ⇒
+    // Σ c out = Σ c f + F exactly, for any relaxation rates.
+    const auto F = random_vector<L, T>(rng, 0.02);
+    collide_node<L, T>(op, f, F.data(), out);
+    post = sums<L>(out);
+    EXPECT_NEAR(post.m0, pre.m0, tol<T>) << op.name << " forced, sample " << sample;
+    for (int a = 0; a < L::d; ++a)
+      EXPECT_NEAR(post.m1[a], pre.m1[a] + F[a], tol<T>) << op.name << " forced, sample " << sample << " a=" << a;
+  }
+}
+
+TYPED_TEST(PointwiseTest, BgkConservesMassAndMomentumAndAddsForce) {
+  using L = typename TypeParam::L;
+  using T = typename TypeParam::T;
+  check_collision_conservation<L, T>(Bgk{0.7}, 21);
+  check_collision_conservation<L, T>(Bgk{1.6}, 22);
+}
+
+TYPED_TEST(PointwiseTest, TrtConservesMassAndMomentumAndAddsForce) {
+  using L = typename TypeParam::L;
+  using T = typename TypeParam::T;
+  check_collision_conservation<L, T>(Trt{0.7, 0.25}, 23);
+  check_collision_conservation<L, T>(Trt{1.6, 3.0 / 16.0}, 24);  // τ− ≠ τ+: odd/even really differ
+}
+
+TYPED_TEST(PointwiseTest, TrtWithEqualRatesIsBgk) {
+  using L = typename TypeParam::L;
+  using T = typename TypeParam::T;
+  std::mt19937 rng(31);
+  for (const double tau : {0.6, 0.8, 1.7}) {
+    const Trt trt{tau, (tau - 0.5) * (tau - 0.5)};  // Λ = (τ − ½)² ⇒ τ− = τ
+    ASSERT_NEAR(trt.tau_minus(), tau, 1e-14);
+    const Bgk bgk{tau};
+    for (int sample = 0; sample < 50; ++sample) {
+      T f[L::q], a[L::q], b[L::q];
+      random_populations<L, T>(rng, f);
+      const auto F = random_vector<L, T>(rng, 0.02);
+      for (const T* force : {static_cast<const T*>(nullptr), F.data()}) {
+        collide_node<L, T>(trt, f, force, a);
+        collide_node<L, T>(bgk, f, force, b);
+        for (int i = 0; i < L::q; ++i)
+          EXPECT_NEAR(a[i], b[i], tol<T>) << "tau " << tau << " i=" << i << (force ? " forced" : "");
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// 4: streaming is a permutation
+
+/// Collision that does nothing: out = f (isolates the push and the periodic ghost copies).
+struct NullCollision {
+  template <class L, class T>
+  void collide(const T (&f)[L::q], const T (&)[L::q], const T*, T (&out)[L::q]) const {
+    for (int i = 0; i < L::q; ++i) out[i] = f[i];
+  }
+};
+
+template <class T>
+auto bits(T v) {
+  if constexpr (std::is_same_v<T, float>)
+    return std::bit_cast<std::uint32_t>(v);
+  else
+    return std::bit_cast<std::uint64_t>(v);
+}
+
+template <int D>
+Vec<D> zero_velocity(const Vec<D>&) {
+  return Vec<D>::Zero();
+}
+
+template <class C>
+class StreamingTest : public ::testing::Test {};
+TYPED_TEST_SUITE(StreamingTest, AllConfigs, ConfigNames);
+
+TYPED_TEST(StreamingTest, PeriodicStreamMovesEveryPopulationByItsVelocity) {
+  using L = typename TypeParam::L;
+  using T = typename TypeParam::T;
+  constexpr int D = L::d, Q = L::q;
+  Index<D> n;
+  if constexpr (D == 2)
+    n = {5, 4};
+  else
+    n = {5, 4, 3};
+  const field::Grid<D> g(n, Vec<D>::Zero(), 1.0);
+  field::Populations<L, T> pop(g);
+  std::mt19937 rng(41);
+  field::for_each_interior<D>(g, [&](const Index<D>& x) {
+    for (int i = 0; i < Q; ++i) pop(i, g.index(x)) = T(uniform(rng, -0.05, 0.05));
+  });
+  const std::vector<T> before(pop.current(), pop.current() + Q * g.size());
+
+  std::array<Kind, D> kinds;
+  kinds.fill(Kind::periodic);
+  const boundary::BoundarySet<L, T> bc(g, kinds, zero_velocity<D>);
+  const NullCollision op;
+  stream_collide<false>(pop, op);
+  bc.apply(pop, op);
+  pop.swap();
+
+  int mismatches = 0;
+  field::for_each_interior<D>(g, [&](const Index<D>& x) {
+    for (int i = 0; i < Q; ++i) {
+      Index<D> src;
+      for (int a = 0; a < D; ++a) src[a] = ((x[a] - L::c[i][a]) % n[a] + n[a]) % n[a];
+      const T expected = before[i * g.size() + g.index(src)];
+      const T got = pop(i, g.index(x));
+      if (bits(got) != bits(expected) && ++mismatches <= 10) {
+        ADD_FAILURE() << "population " << i << " at node (" << x[0] << "," << x[1] << (D == 3 ? "," : "")
+                      << (D == 3 ? std::to_string(x[D - 1]) : "") << "): got " << got << ", expected " << expected;
+      }
+    }
+  });
+  EXPECT_EQ(mismatches, 0);
+}
+
+// ---------------------------------------------------------------------------------------
+// 5–7: a whole block (sim::Fluid) with periodic, wall and far-field boundaries
+
+template <class L>
+Index<L::d> box_size() {
+  if constexpr (L::d == 2)
+    return {12, 10};
+  else
+    return {8, 6, 5};
+}
+
+template <class L, class T, class Op>
+sim::Fluid<L, T, Op> make_box(Kind kind, const Op& op, const Vec<L::d>& force = Vec<L::d>::Zero(),
+                              const Vec<L::d>& imposed = Vec<L::d>::Zero()) {
+  constexpr int D = L::d;
+  typename sim::Fluid<L, T, Op>::Setup s;
+  s.coarse = field::Grid<D>(box_size<L>(), Vec<D>::Zero(), 1.0);
+  s.boundaries.fill(kind);
+  s.imposed_velocity_lu = [imposed](const Vec<D>&) { return imposed; };
+  s.coarse_op = op;
+  s.body_force_lu = force;
+  return sim::Fluid<L, T, Op>(s);
+}
+
+/// Random small perturbation of the rest state: local equilibria of random (ρ, u) plus
+/// random non-equilibrium parts, written straight into the populations.
+template <class L, class T, class Op>
+void perturb(sim::Fluid<L, T, Op>& fluid, unsigned seed) {
+  std::mt19937 rng(seed);
+  auto& pop = fluid.coarse().pop;
+  const auto& g = pop.grid();
+  field::for_each_interior<L::d>(g, [&](const Index<L::d>& x) {
+    const double rho = uniform(rng, 0.97, 1.03);
+    const auto u = random_vector<L, double>(rng, 0.03);
+    double feq[L::q];
+    equilibrium<L, double>(rho, u, feq);
+    for (int i = 0; i < L::q; ++i) pop(i, g.index(x)) = T(feq[i] + L::w[i] * uniform(rng, -0.01, 0.01));
+  });
+}
+
+/// Total mass Σ(w + f) and momentum Σ c f (pre-collision, without the half force) of the block.
+template <class L>
+struct Totals {
+  double mass = 0;
+  Vec<L::d> momentum = Vec<L::d>::Zero();
+};
+
+template <class L, class T, class Op>
+Totals<L> totals(const sim::Fluid<L, T, Op>& fluid) {
+  Totals<L> t;
+  const auto& pop = fluid.coarse().pop;
+  field::for_each_interior<L::d>(pop.grid(), [&](const Index<L::d>& x) {
+    const auto n = pop.grid().index(x);
+    for (int i = 0; i < L::q; ++i) {
+      t.mass += L::w[i] + double(pop(i, n));
+      for (int a = 0; a < L::d; ++a) t.momentum[a] += L::c[i][a] * double(pop(i, n));
+    }
+  });
+  return t;
+}
+
+template <class L>
+class BlockTest : public ::testing::Test {};
+TYPED_TEST_SUITE(BlockTest, Lattices, LatticeNames);
+
+/// Periodic block, no force: mass (relative) and momentum (relative to the mass) conserved.
+template <class L, class T, class Op>
+void check_periodic_conservation(const Op& op, double mass_tol, double momentum_tol) {
+  auto fluid = make_box<L, T>(Kind::periodic, op);
+  perturb(fluid, 51);
+  const auto t0 = totals(fluid);
+  for (int step = 1; step <= 50; ++step) {
+    fluid.step();
+    const auto t = totals(fluid);
+    ASSERT_NEAR(t.mass, t0.mass, mass_tol * t0.mass) << op.name << " step " << step;
+    for (int a = 0; a < L::d; ++a)
+      ASSERT_NEAR(t.momentum[a], t0.momentum[a], momentum_tol * t0.mass) << op.name << " step " << step;
+  }
+}
+
+TYPED_TEST(BlockTest, PeriodicFluidConservesMassAndMomentumDouble) {
+  using L = TypeParam;
+  check_periodic_conservation<L, double>(Bgk{0.8}, 1e-12, 1e-12);
+  check_periodic_conservation<L, double>(Trt{0.8, 0.25}, 1e-12, 1e-12);
+}
+
+TYPED_TEST(BlockTest, PeriodicFluidConservesMassFloat) {
+  using L = TypeParam;
+  check_periodic_conservation<L, float>(Bgk{0.8}, 1e-5, 1e-5);
+  check_periodic_conservation<L, float>(Trt{0.8, 0.25}, 1e-5, 1e-5);
+}
+
+/// Periodic block with a uniform body force: total momentum grows by exactly N·F per step.
+template <class L, class Op>
+void check_body_force_momentum(const Op& op) {
+  constexpr int D = L::d;
+  Vec<D> F;
+  if constexpr (D == 2)
+    F = Vec<2>(2e-4, -1e-4);
+  else
+    F = Vec<3>(2e-4, -1e-4, 5e-5);
+  auto fluid = make_box<L, double>(Kind::periodic, op, F);
+  perturb(fluid, 52);
+  const double N = static_cast<double>(fluid.coarse().pop.grid().interior_size());
+  const Vec<D> NF = N * F;
+  const auto t0 = totals(fluid);
+  auto prev = t0;
+  const int steps = 50;
+  for (int step = 1; step <= steps; ++step) {
+    fluid.step();
+    const auto t = totals(fluid);
+    ASSERT_NEAR(t.mass, t0.mass, 1e-12 * t0.mass) << op.name << " step " << step;
+    for (int a = 0; a < D; ++a)
+      ASSERT_NEAR(t.momentum[a] - prev.momentum[a], NF[a], 1e-10 * NF.norm()) << op.name << " step " << step;
+    prev = t;
+  }
+  for (int a = 0; a < D; ++a)
+    EXPECT_NEAR(prev.momentum[a] - t0.momentum[a], steps * NF[a], 1e-10 * steps * NF.norm()) << op.name;
+}
+
+TYPED_TEST(BlockTest, BodyForceAddsNTimesFPerStep) {
+  check_body_force_momentum<TypeParam>(Bgk{0.8});
+  check_body_force_momentum<TypeParam>(Trt{0.8, 0.25});
+  check_body_force_momentum<TypeParam>(Trt{1.3, 3.0 / 16.0});
+}
+
+/// Closed box, resting half-way bounce-back walls on every face: mass conserved.
+template <class L, class T, class Op>
+void check_wall_box_mass(const Op& op, double mass_tol) {
+  auto fluid = make_box<L, T>(Kind::wall, op);
+  perturb(fluid, 61);
+  const auto t0 = totals(fluid);
+  for (int step = 1; step <= 200; ++step) {
+    fluid.step();
+    ASSERT_NEAR(totals(fluid).mass, t0.mass, mass_tol * t0.mass) << op.name << " step " << step;
+  }
+}
+
+TYPED_TEST(BlockTest, BounceBackWallsConserveMassInClosedBox) {
+  using L = TypeParam;
+  check_wall_box_mass<L, double>(Bgk{0.8}, 1e-12);
+  check_wall_box_mass<L, double>(Trt{0.8, 0.25}, 1e-12);
+  check_wall_box_mass<L, float>(Bgk{0.8}, 1e-5);
+}
+
+/// Far field on every face with the imposed flow u0, initialised to the uniform equilibrium
+/// (ρ0, u0): every population stays at that equilibrium.
+template <class L, class Op>
+void check_far_field_uniform_flow(const Op& op) {
+  constexpr int D = L::d;
+  Vec<D> u0;
+  if constexpr (D == 2)
+    u0 = Vec<2>(0.05, -0.03);
+  else
+    u0 = Vec<3>(0.05, -0.03, 0.02);
+  const double rho0 = 1.01;
+  auto fluid = make_box<L, double>(Kind::far_field, op, Vec<D>::Zero(), u0);
+  fluid.initialise([&](const Vec<D>&) { return std::pair{rho0, u0}; });
+  std::array<double, D> uu;
+  for (int a = 0; a < D; ++a) uu[a] = u0[a];
+  double feq[L::q];
+  equilibrium<L, double>(rho0, uu, feq);
+  for (int step = 0; step < 100; ++step) fluid.step();
+  const auto& pop = fluid.coarse().pop;
+  int bad = 0;
+  field::for_each_interior<D>(pop.grid(), [&](const Index<D>& x) {
+    const auto n = pop.grid().index(x);
+    for (int i = 0; i < L::q; ++i)
+      if (std::abs(pop(i, n) - feq[i]) > 1e-13 && ++bad <= 10)
+        ADD_FAILURE() << op.name << " population " << i << " at node " << n << ": " << pop(i, n) << " vs "
+                      << feq[i];
+    const auto m = node_moments(pop, n);
+    bool moments_ok = std::abs(m.rho - rho0) <= 1e-13;
+    for (int a = 0; a < D; ++a) moments_ok = moments_ok && std::abs(m.u[a] - u0[a]) <= 1e-13;
+    if (!moments_ok && ++bad <= 10) ADD_FAILURE() << op.name << " node " << n << ": rho " << m.rho << ", u0 " << m.u[0];
+  });
+  EXPECT_EQ(bad, 0) << op.name;
+}
+
+TYPED_TEST(BlockTest, FarFieldKeepsUniformFlowUniform) {
+  check_far_field_uniform_flow<TypeParam>(Bgk{0.8});
+  check_far_field_uniform_flow<TypeParam>(Trt{0.8, 0.25});
+  check_far_field_uniform_flow<TypeParam>(Trt{1.5, 3.0 / 16.0});
+}
+
+}  // namespace
+}  // namespace caplab::collision
