@@ -1,6 +1,7 @@
 #include <fmt/format.h>
 
 #include "app/commands.hpp"
+#include "bench/bench.hpp"
 #include "score/score_run.hpp"
 #include "score/scorecard.hpp"
 
@@ -12,9 +13,12 @@ int score(const ScoreArgs& args) {
   return score::exit_code(s, args.strict);
 }
 
-int bench(const BenchArgs&) {
-  fmt::print("caplab bench: not yet built\n");
-  return 4;
+int bench(const BenchArgs& args) {
+  bench::BenchOptions opt;
+  opt.quick = args.quick;
+  opt.output_dir = args.out;
+  bench::run_benchmarks(opt);  // prints its table and writes bench.json
+  return 0;
 }
 
 }  // namespace caplab::app

@@ -82,7 +82,7 @@ class BoundarySet {
     for (int a = 0; a < D; ++a) ub[a] = T(s.u_b[a]);
     collision::equilibrium<L, T>(m.rho, ub, feq_b);
     for (int i = 0; i < Q; ++i) fb[i] = feq_b[i] + (f[i] - feq_f[i]);
-    op.template collide<L, T>(fb, feq_b, nullptr, post);
+    op.template collide<L, T>(fb, feq_b, post);
   }
 
   void add_ghost(const field::Grid<D>& g, const std::array<Kind, D>& kinds, const VelocityField& imposed,

@@ -11,33 +11,63 @@
 
 namespace caplab::collision {
 
-/// Density and velocity of one node from its shifted populations.
+/// ρ = 1 + Σ f_i and j = Σ c_i f_i from shifted populations f.
+/// Scalars and references to C arrays only: this is what the vectorized kernel calls (an
+/// aggregate or a pointer to a per-lane array inside an `omp simd` loop stops GCC 12 from
+/// vectorizing it; checked with -fopt-info-vec).
+template <class L, class T>
+inline void density_momentum(const T (&f)[L::q], T& rho, T (&j)[L::d]) {
+  T drho = 0;
+  for (int a = 0; a < L::d; ++a) j[a] = 0;
+#pragma GCC unroll 19
+  for (int i = 0; i < L::q; ++i) {
+    drho += f[i];
+    for (int a = 0; a < L::d; ++a) j[a] += T(L::c[i][a]) * f[i];
+  }
+  rho = T(1) + drho;
+}
+
+/// ρ and u = Σ c_i f_i / ρ (no force).
+template <class L, class T>
+inline void moments(const T (&f)[L::q], T& rho, T (&u)[L::d]) {
+  density_momentum<L, T>(f, rho, u);
+  const T inv_rho = T(1) / rho;
+  for (int a = 0; a < L::d; ++a) u[a] *= inv_rho;
+}
+
+/// ρ and u = (Σ c_i f_i + F/2)/ρ (Guo forcing, thesis eq. 2.25).
+template <class L, class T>
+inline void moments(const T (&f)[L::q], const T (&F)[L::d], T& rho, T (&u)[L::d]) {
+  density_momentum<L, T>(f, rho, u);
+  const T inv_rho = T(1) / rho;
+  for (int a = 0; a < L::d; ++a) u[a] = (u[a] + T(0.5) * F[a]) * inv_rho;
+}
+
+/// Density and velocity of one node (for code outside the kernel).
 template <class L, class T>
 struct Moments {
   T rho;
   std::array<T, L::d> u;
 };
 
-/// ρ = 1 + Σ f_i and u = (Σ c_i f_i + F/2)/ρ from shifted populations f (F may be zero).
 template <class L, class T>
 inline Moments<L, T> moments(const T (&f)[L::q], const T* force = nullptr) {
   Moments<L, T> m;
-  T drho = 0;
-  std::array<T, L::d> j{};
-#pragma GCC unroll 19
-  for (int i = 0; i < L::q; ++i) {
-    drho += f[i];
-    for (int a = 0; a < L::d; ++a) j[a] += T(L::c[i][a]) * f[i];
+  T u[L::d];
+  if (force) {
+    T F[L::d];
+    for (int a = 0; a < L::d; ++a) F[a] = force[a];
+    moments<L, T>(f, F, m.rho, u);
+  } else {
+    moments<L, T>(f, m.rho, u);
   }
-  m.rho = T(1) + drho;
-  const T inv_rho = T(1) / m.rho;
-  for (int a = 0; a < L::d; ++a) m.u[a] = (j[a] + (force ? T(0.5) * force[a] : T(0))) * inv_rho;
+  for (int a = 0; a < L::d; ++a) m.u[a] = u[a];
   return m;
 }
 
-/// Shifted equilibrium f_eq_i − w_i for all i.
+/// Shifted equilibrium f_eq_i − w_i for all i; u points to D components.
 template <class L, class T>
-inline void equilibrium(T rho, const std::array<T, L::d>& u, T (&feq)[L::q]) {
+inline void equilibrium(T rho, const T (&u)[L::d], T (&feq)[L::q]) {
   constexpr T inv_cs2 = T(3);
   T usq = 0;
   for (int a = 0; a < L::d; ++a) usq += u[a] * u[a];
@@ -49,10 +79,16 @@ inline void equilibrium(T rho, const std::array<T, L::d>& u, T (&feq)[L::q]) {
     feq[i] = T(L::w[i]) * (drho + rho * (inv_cs2 * cu + T(4.5) * cu * cu - T(1.5) * usq));
   }
 }
+template <class L, class T>
+inline void equilibrium(T rho, const std::array<T, L::d>& u, T (&feq)[L::q]) {
+  T v[L::d];
+  for (int a = 0; a < L::d; ++a) v[a] = u[a];
+  equilibrium<L, T>(rho, v, feq);
+}
 
 /// Guo source S_i (without the (1 − ω/2) factor) for force density F and velocity u.
 template <class L, class T>
-inline void guo_source(const std::array<T, L::d>& u, const T* force, T (&s)[L::q]) {
+inline void guo_source(const T (&u)[L::d], const T (&force)[L::d], T (&s)[L::q]) {
   T uF = 0;
   for (int a = 0; a < L::d; ++a) uF += u[a] * force[a];
 #pragma GCC unroll 19
@@ -64,6 +100,12 @@ inline void guo_source(const std::array<T, L::d>& u, const T* force, T (&s)[L::q
     }
     s[i] = T(L::w[i]) * (T(3) * (cF - uF) + T(9) * cu * cF);
   }
+}
+template <class L, class T>
+inline void guo_source(const std::array<T, L::d>& u, const T* force, T (&s)[L::q]) {
+  T v[L::d], F[L::d];
+  for (int a = 0; a < L::d; ++a) v[a] = u[a], F[a] = force[a];
+  guo_source<L, T>(v, F, s);
 }
 
 }  // namespace caplab::collision

@@ -21,16 +21,20 @@ struct Bgk {
   /// Relaxation time of the odd (antisymmetric) non-equilibrium part; BGK relaxes both alike.
   double tau_minus() const { return tau; }
 
-  /// Post-collision values from pre-collision f, equilibrium feq and source s (s may be null).
+  /// Post-collision values from pre-collision f and equilibrium feq.
   template <class L, class T>
-  inline void collide(const T (&f)[L::q], const T (&feq)[L::q], const T* s, T (&out)[L::q]) const {
+  inline void collide(const T (&f)[L::q], const T (&feq)[L::q], T (&out)[L::q]) const {
+    const T omega = T(1.0 / tau);
+#pragma GCC unroll 19
+    for (int i = 0; i < L::q; ++i) out[i] = f[i] - omega * (f[i] - feq[i]);
+  }
+  /// The same with the Guo source s, weighted (1 − ω/2).
+  template <class L, class T>
+  inline void collide(const T (&f)[L::q], const T (&feq)[L::q], const T (&s)[L::q], T (&out)[L::q]) const {
     const T omega = T(1.0 / tau);
     const T source_factor = T(1) - T(0.5) * omega;
 #pragma GCC unroll 19
-    for (int i = 0; i < L::q; ++i) {
-      out[i] = f[i] - omega * (f[i] - feq[i]);
-      if (s) out[i] += source_factor * s[i];
-    }
+    for (int i = 0; i < L::q; ++i) out[i] = f[i] - omega * (f[i] - feq[i]) + source_factor * s[i];
   }
 };
 
@@ -43,7 +47,19 @@ struct Trt {
   double tau_minus() const { return 0.5 + magic / (tau - 0.5); }
 
   template <class L, class T>
-  inline void collide(const T (&f)[L::q], const T (&feq)[L::q], const T* s, T (&out)[L::q]) const {
+  inline void collide(const T (&f)[L::q], const T (&feq)[L::q], T (&out)[L::q]) const {
+    const T wp = T(1.0 / tau), wm = T(1.0 / tau_minus());
+#pragma GCC unroll 19
+    for (int i = 0; i < L::q; ++i) {
+      const int o = L::opposite[i];
+      const T np = T(0.5) * ((f[i] - feq[i]) + (f[o] - feq[o]));
+      const T nm = T(0.5) * ((f[i] - feq[i]) - (f[o] - feq[o]));
+      out[i] = f[i] - wp * np - wm * nm;
+    }
+  }
+  /// The same with the Guo source s: even part weighted (1 − ω+/2), odd part (1 − ω−/2).
+  template <class L, class T>
+  inline void collide(const T (&f)[L::q], const T (&feq)[L::q], const T (&s)[L::q], T (&out)[L::q]) const {
     const T wp = T(1.0 / tau), wm = T(1.0 / tau_minus());
     const T sp = T(1) - T(0.5) * wp, sm = T(1) - T(0.5) * wm;
 #pragma GCC unroll 19
@@ -51,8 +67,7 @@ struct Trt {
       const int o = L::opposite[i];
       const T np = T(0.5) * ((f[i] - feq[i]) + (f[o] - feq[o]));
       const T nm = T(0.5) * ((f[i] - feq[i]) - (f[o] - feq[o]));
-      out[i] = f[i] - wp * np - wm * nm;
-      if (s) out[i] += sp * T(0.5) * (s[i] + s[o]) + sm * T(0.5) * (s[i] - s[o]);
+      out[i] = f[i] - wp * np - wm * nm + sp * T(0.5) * (s[i] + s[o]) + sm * T(0.5) * (s[i] - s[o]);
     }
   }
 };

@@ -51,26 +51,35 @@ void stream_collide(field::Populations<L, T>& pop, const Op& op,
     for (int a = 0; a < D; ++a) fp[a] = force->comp[a].data();
 
   parallel_rows<D>(g, [&](std::ptrdiff_t base, int nx) {
+    // Loop invariants in locals: read through the closure they are reloaded every iteration
+    // and GCC does not vectorize the loop (measured: D3Q19 double 42 -> 94 MLUPS, 2 threads).
+    const T* __restrict src_l = src;
+    T* __restrict dst_l = dst;
+    const std::ptrdiff_t N_l = N;
+    const auto off_l = off;
+    const Op op_l = op;
+    const double* fp_l[D];
+    for (int a = 0; a < D; ++a) fp_l[a] = fp[a];
 #pragma omp simd
     for (int x = 0; x < nx; ++x) {
       const std::ptrdiff_t n = base + x;
-      T f[Q], feq[Q], out[Q];
+      T f[Q], feq[Q], out[Q], rho, u[D];
 #pragma GCC unroll 19
-      for (int i = 0; i < Q; ++i) f[i] = src[i * N + n];
+      for (int i = 0; i < Q; ++i) f[i] = src_l[i * N_l + n];
       if constexpr (Forced) {
         T F[D], s[Q];
-        for (int a = 0; a < D; ++a) F[a] = T(fp[a][n]);
-        const auto m = moments<L, T>(f, F);
-        equilibrium<L, T>(m.rho, m.u, feq);
-        guo_source<L, T>(m.u, F, s);
-        op.template collide<L, T>(f, feq, s, out);
+        for (int a = 0; a < D; ++a) F[a] = T(fp_l[a][n]);
+        moments<L, T>(f, F, rho, u);
+        equilibrium<L, T>(rho, u, feq);
+        guo_source<L, T>(u, F, s);
+        op_l.template collide<L, T>(f, feq, s, out);
       } else {
-        const auto m = moments<L, T>(f);
-        equilibrium<L, T>(m.rho, m.u, feq);
-        op.template collide<L, T>(f, feq, nullptr, out);
+        moments<L, T>(f, rho, u);
+        equilibrium<L, T>(rho, u, feq);
+        op_l.template collide<L, T>(f, feq, out);
       }
 #pragma GCC unroll 19
-      for (int i = 0; i < Q; ++i) dst[i * N + n + off[i]] = out[i];
+      for (int i = 0; i < Q; ++i) dst_l[i * N_l + n + off_l[i]] = out[i];
     }
   });
 }

@@ -97,7 +97,7 @@ class TwoLevel {
       const auto mo = collision::moments<L, T>(f);
       collision::equilibrium<L, T>(mo.rho, mo.u, feq);
       rescale_non_equilibrium(f, feq, f_from_c_, f);
-      op_fine.template collide<L, T>(f, feq, nullptr, post);
+      op_fine.template collide<L, T>(f, feq, post);
       for (int l = gh.first_link; l < gh.first_link + gh.link_count; ++l)
         next[links_[l].i * N + links_[l].dst] = post[links_[l].i];
     }

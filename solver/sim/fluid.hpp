@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "boundary/boundary_set.hpp"
+#include "core/timing.hpp"
 #include "collision/stream_collide.hpp"
 #include "refinement/two_level.hpp"
 
@@ -88,12 +89,12 @@ class Fluid {
       return;
     }
     advance_block(c, {}, [&] { coarse_bc_.apply(c.pop, c.op); });
-    timed(coupling_seconds_, [&] { coupling_.capture_coarse(c.pop); });
+    core::timed(coupling_seconds_, [&] { coupling_.capture_coarse(c.pop); });
     auto& f = blocks_[1];
     for (int sub = 0; sub < 2; ++sub)
       advance_block(f, hook,
-                    [&] { timed(coupling_seconds_, [&] { coupling_.fill_fine_ghosts(f.pop, f.op, 0.5 * sub); }); });
-    timed(coupling_seconds_, [&] { coupling_.restrict_to_coarse(c.pop, f.pop); });
+                    [&] { core::timed(coupling_seconds_, [&] { coupling_.fill_fine_ghosts(f.pop, f.op, 0.5 * sub); }); });
+    core::timed(coupling_seconds_, [&] { coupling_.restrict_to_coarse(c.pop, f.pop); });
   }
 
   /// Wall time spent in the multi-block coupling so far (part of the step time).
@@ -135,13 +136,6 @@ class Fluid {
       collision::stream_collide<false>(blk.pop, blk.op);
     apply_boundaries();
     blk.pop.swap();
-  }
-
-  template <class F>
-  static void timed(double& acc, F&& f) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    acc += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
 
   std::vector<Block> blocks_;

@@ -19,6 +19,7 @@
 
 #include "case/case_spec.hpp"
 #include "core/error.hpp"
+#include "core/timing.hpp"
 #include "diagnostics/signal.hpp"
 #include "geometry/marker_set.hpp"
 #include "ibm/direct_forcing.hpp"
@@ -82,15 +83,15 @@ class Scene {
     auto hook = [&](const typename FluidT::Pop& pop, typename FluidT::Force& f) { return apply_ib(pop, f); };
     std::vector<double> row(columns_.size());
     for (long step = 1; step <= total; ++step) {
-      timed(seconds_fluid_, [&] { fluid_.step(hook); });
+      core::timed(seconds_fluid_, [&] { fluid_.step(hook); });
       const double t = step * dt;
-      if (step % guard_every == 0 || step == total) timed(seconds_diagnostics_, [&] { check_guards(step); });
+      if (step % guard_every == 0 || step == total) core::timed(seconds_diagnostics_, [&] { check_guards(step); });
       if (step % sample_every == 0 || step == total) {
-        timed(seconds_diagnostics_, [&] { sample(t, row); });
-        timed(seconds_output_, [&] { series.append(row); });
+        core::timed(seconds_diagnostics_, [&] { sample(t, row); });
+        core::timed(seconds_output_, [&] { series.append(row); });
       }
       if (snapshots && std::find(snapshot_steps.begin(), snapshot_steps.end(), step) != snapshot_steps.end())
-        timed(seconds_output_, [&] { write_snapshot(*snapshots, t); });
+        core::timed(seconds_output_, [&] { write_snapshot(*snapshots, t); });
       if (progress && clock::now() - last_report > std::chrono::seconds(1)) {
         const double wall = std::chrono::duration<double>(clock::now() - start).count();
         progress(step, total, t, fluid_.updates_per_step() * step / wall / 1e6);
@@ -220,7 +221,11 @@ class Scene {
   /// The IB stage of one finest-block step: adds the bodies' force density to f.
   bool apply_ib(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
     if (bodies_.empty()) return false;
-    const auto t0 = std::chrono::steady_clock::now();
+    core::timed(seconds_ib_, [&] { force_bodies(pop, f); });
+    return true;
+  }
+
+  void force_bodies(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
     auto u_star = [&](const Index<D>&, std::ptrdiff_t n) {
       const auto m = collision::node_moments<L, T>(pop, n);
       Vec<D> u;
@@ -236,8 +241,6 @@ class Scene {
           },
           b.forcing);
     }
-    seconds_ib_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return true;
   }
 
   /// Drag along the flow direction, lift perpendicular to it (in the x–y plane).
@@ -442,13 +445,6 @@ class Scene {
     nlohmann::json sanity = {{"finite", true}};
     if (series.count("mass")) sanity["mass_drift"] = std::abs(series.at("mass").back() - 1.0);
     return {{"case_id", spec_.id}, {"fidelity", spec_.fidelity}, {"metrics", metrics}, {"sanity", sanity}};
-  }
-
-  template <class F>
-  static void timed(double& acc, F&& f) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    acc += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
 
   const cases::CaseSpec& spec_;

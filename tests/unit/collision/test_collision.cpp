@@ -114,7 +114,7 @@ void collide_node(const Op& op, const T (&f)[L::q], const T* F, T (&out)[L::q]) 
     guo_source<L, T>(m.u, F, s);
     op.template collide<L, T>(f, feq, s, out);
   } else {
-    op.template collide<L, T>(f, feq, nullptr, out);
+    op.template collide<L, T>(f, feq, out);
   }
 }
 
@@ -238,7 +238,7 @@ TYPED_TEST(PointwiseTest, TrtWithEqualRatesIsBgk) {
 /// Collision that does nothing: out = f (isolates the push and the periodic ghost copies).
 struct NullCollision {
   template <class L, class T>
-  void collide(const T (&f)[L::q], const T (&)[L::q], const T*, T (&out)[L::q]) const {
+  void collide(const T (&f)[L::q], const T (&)[L::q], T (&out)[L::q]) const {
     for (int i = 0; i < L::q; ++i) out[i] = f[i];
   }
 };

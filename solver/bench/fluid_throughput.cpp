@@ -1,0 +1,173 @@
+#include "bench/fluid_throughput.hpp"
+
+#include <omp.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <utility>
+
+#include "core/error.hpp"
+#include "lattice/lattice.hpp"
+#include "sim/fluid.hpp"
+
+namespace caplab::bench {
+
+namespace {
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// User + system CPU time of the whole process (all threads).
+double process_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  auto sec = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * t.tv_usec; };
+  return sec(u.ru_utime) + sec(u.ru_stime);
+}
+
+/// Sets the OpenMP thread count for its lifetime and restores the previous one.
+class ThreadScope {
+ public:
+  explicit ThreadScope(int threads) : saved_(omp_get_max_threads()) { omp_set_num_threads(threads); }
+  ~ThreadScope() { omp_set_num_threads(saved_); }
+  ThreadScope(const ThreadScope&) = delete;
+  ThreadScope& operator=(const ThreadScope&) = delete;
+
+ private:
+  int saved_;
+};
+
+template <class T>
+constexpr const char* precision_name() {
+  return sizeof(T) == 8 ? "double" : "float";
+}
+
+template <class L, class T, class Op>
+FluidMeasurement measure(const FluidCase& c, double min_seconds) {
+  constexpr int D = L::d;
+  using FluidT = sim::Fluid<L, T, Op>;
+  ThreadScope scope(c.threads);
+
+  typename FluidT::Setup s;
+  Index<D> n;
+  n.fill(c.n);
+  s.coarse = field::Grid<D>(n, Vec<D>::Zero(), 1.0);
+  FluidMeasurement r;
+  r.size.assign(D, c.n);
+  if (c.two_level) {
+    // Centred block of `side` coarse cells per axis, side^D ≈ n^D / 8. Its ghost ring lies on
+    // coarse nodes lo and hi (the layout of refinement/two_level.hpp).
+    const int side = std::max(2, static_cast<int>(std::lround(c.n * std::pow(0.125, 1.0 / D))));
+    const int lo = (c.n - side) / 2;
+    Index<D> nf;
+    Vec<D> of;
+    for (int a = 0; a < D; ++a) nf[a] = 2 * side - 1, of[a] = lo + 0.5;
+    s.fine = field::Grid<D>(nf, of, 0.5);
+    r.fine_size.assign(D, 2 * side - 1);
+    r.fine_fraction = std::pow(static_cast<double>(side) / c.n, D);
+  }
+  s.boundaries.fill(boundary::Kind::periodic);
+  s.imposed_velocity_lu = [](const Vec<D>&) { return Vec<D>::Zero(); };
+  s.coarse_op.tau = 0.8;
+
+  FluidT fluid(s);
+  const double k = 2 * std::numbers::pi / c.n;
+  fluid.initialise([&](const Vec<D>& x) {
+    Vec<D> u = Vec<D>::Constant(0.02);
+    u[0] = 0.05;
+    u[0] += 0.01 * std::sin(k * x[0]) * std::cos(k * x[1]);
+    u[1] -= 0.01 * std::cos(k * x[0]) * std::sin(k * x[1]);
+    return std::pair<double, Vec<D>>(1.0, u);
+  });
+
+  fluid.step();  // warm-up (first touch of the next buffer happens here)
+  double t0 = now_seconds();
+  fluid.step();
+  const double t_step = std::max(now_seconds() - t0, 1e-9);
+  const long batch = std::max(1L, static_cast<long>(std::ceil(min_seconds / 5 / t_step)));
+
+  const double coupling0 = fluid.coupling_seconds();
+  const double cpu0 = process_cpu_seconds();
+  double elapsed = 0;
+  int batches = 0;
+  while (elapsed < min_seconds || batches < 3) {
+    t0 = now_seconds();
+    for (long i = 0; i < batch; ++i) fluid.step();
+    const double t = now_seconds() - t0;
+    elapsed += t;
+    ++batches;
+    r.mlups_best = std::max(r.mlups_best, batch * fluid.updates_per_step() / t * 1e-6);
+  }
+  r.updates_per_step = fluid.updates_per_step();
+  r.steps = batch * batches;
+  r.seconds = elapsed;
+  r.mlups = r.steps * r.updates_per_step / elapsed * 1e-6;
+  r.coupling_seconds = fluid.coupling_seconds() - coupling0;
+  r.cpu_share = (process_cpu_seconds() - cpu0) / (c.threads * elapsed);
+  r.bytes_per_update = field::Populations<L, T>::bytes_per_update();
+  r.bytes_per_update_write_allocate = 3 * L::q * sizeof(T);
+
+  // Sanity, separate from speed: a benchmark of a broken flow is not a result.
+  for (std::size_t b = 0; b < fluid.block_count(); ++b) {
+    const auto& pop = fluid.block(b).pop;
+    Index<D> mid;
+    for (int a = 0; a < D; ++a) mid[a] = pop.grid().n()[a] / 2;
+    const auto m = collision::node_moments(pop, pop.grid().index(mid));
+    CAPLAB_CHECK(std::isfinite(static_cast<double>(m.rho)) && std::abs(m.rho - 1.0) < 0.1,
+                 "bench: the benchmark flow is not finite or drifted; the measurement is void");
+  }
+  return r;
+}
+
+using Measure = FluidMeasurement (*)(const FluidCase&, double);
+
+struct Entry {
+  const char* lattice;
+  const char* collision;
+  const char* precision;
+  Measure measure;
+};
+
+template <class L, class Op, class T>
+constexpr Entry entry() {
+  return {L::name, Op::name, precision_name<T>(), &measure<L, T, Op>};
+}
+
+// Every supported combination, compiled once; names come from the types themselves.
+constexpr std::array<Entry, 8> kEntries{
+    entry<lattice::D2Q9, collision::Bgk, double>(),  entry<lattice::D2Q9, collision::Bgk, float>(),
+    entry<lattice::D2Q9, collision::Trt, double>(),  entry<lattice::D2Q9, collision::Trt, float>(),
+    entry<lattice::D3Q19, collision::Bgk, double>(), entry<lattice::D3Q19, collision::Bgk, float>(),
+    entry<lattice::D3Q19, collision::Trt, double>(), entry<lattice::D3Q19, collision::Trt, float>()};
+
+}  // namespace
+
+const std::vector<std::string>& supported_lattices() {
+  static const std::vector<std::string> v{lattice::D2Q9::name, lattice::D3Q19::name};
+  return v;
+}
+const std::vector<std::string>& supported_collisions() {
+  static const std::vector<std::string> v{collision::Bgk::name, collision::Trt::name};
+  return v;
+}
+const std::vector<std::string>& supported_precisions() {
+  static const std::vector<std::string> v{"double", "float"};
+  return v;
+}
+
+FluidMeasurement measure_fluid(const FluidCase& c, double min_seconds) {
+  CAPLAB_CHECK(c.threads >= 1, "bench: a fluid measurement needs at least one thread");
+  for (const auto& e : kEntries)
+    if (c.lattice == e.lattice && c.collision == e.collision && c.precision == e.precision)
+      return e.measure(c, min_seconds);
+  throw core::InputError("bench: unsupported configuration " + c.lattice + "/" + c.collision + "/" +
+                         c.precision +
+                         "; supported: lattice D2Q9|D3Q19, collision bgk|trt, precision double|float");
+}
+
+}  // namespace caplab::bench
