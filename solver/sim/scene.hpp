@@ -83,6 +83,7 @@ class Scene {
     auto hook = [&](const typename FluidT::Pop& pop, typename FluidT::Force& f) { return apply_ib(pop, f); };
     std::vector<double> row(columns_.size());
     for (long step = 1; step <= total; ++step) {
+      step_ = step;
       core::timed(seconds_fluid_, [&] { fluid_.step(hook); });
       const double t = step * dt;
       if (step % guard_every == 0 || step == total) core::timed(seconds_diagnostics_, [&] { check_guards(step); });
@@ -234,12 +235,21 @@ class Scene {
     };
     auto rho = [&](const Index<D>&, std::ptrdiff_t n) { return collision::node_moments<L, T>(pop, n).rho; };
     for (auto& b : bodies_) {
-      std::visit(
-          [&](auto& forcing) {
-            forcing.apply(pop.grid(), periodic_, b.markers.X, b.desired_lu, b.weight_lu, u_star, rho, f);
-            b.force_on_body_lu = -forcing.total_force_on_fluid();
-          },
-          b.forcing);
+      try {
+        std::visit(
+            [&](auto& forcing) {
+              forcing.apply(pop.grid(), periodic_, b.markers.X, b.desired_lu, b.weight_lu, u_star, rho, f);
+              b.force_on_body_lu = -forcing.total_force_on_fluid();
+            },
+            b.forcing);
+      } catch (const core::NumericalError&) {
+        throw;
+      } catch (const core::Error& e) {
+        // The IB stage sees a diverged flow first (it checks every stencil node every step).
+        throw core::NumericalError(step_, fmt::format("immersed boundary of body '{}'", b.name), e.what(),
+                                   "the flow diverged next to the body; see the guard message for the usual fixes "
+                                   "(TRT, a finer grid, a lower numerics.lattice_velocity, tau further from 1/2)");
+      }
     }
   }
 
@@ -454,6 +464,7 @@ class Scene {
   std::array<bool, D> periodic_{};
   std::vector<io::SeriesColumn> columns_;
   double mass0_ = 1.0;
+  long step_ = 0;  // the coarse step in progress (for messages)
   double seconds_fluid_ = 0, seconds_ib_ = 0, seconds_diagnostics_ = 0, seconds_output_ = 0;
 };
 

@@ -100,12 +100,10 @@ void expect_cylinder_common(const CaseSpec& spec) {
   EXPECT_EQ(n.grid.refinement, GridSpec::Refinement::two_level);
   EXPECT_EQ(n.grid.fine_min, (std::vector<double>{8, 8}));
   EXPECT_EQ(n.grid.fine_max, (std::vector<double>{16, 12}));
-  EXPECT_EQ(n.collision.op, CollisionSpec::Operator::bgk);
   EXPECT_EQ(n.precision, Precision::double_);
   EXPECT_EQ(n.ib.kernel, IbSpec::Kernel::cosine4);
   EXPECT_DOUBLE_EQ(n.ib.marker_spacing, 0.79);
   EXPECT_EQ(n.ib.forcing_iterations, 1);
-  EXPECT_DOUBLE_EQ(n.lattice_velocity, 0.1);
   EXPECT_EQ(n.threads, 0);
 
   EXPECT_DOUBLE_EQ(spec.outputs.series.interval, 0.1);
@@ -133,15 +131,22 @@ TEST(case_cylinder, LoadsAtStandardAndThesis) {
     EXPECT_EQ(spec.outputs.snapshots.times, (std::vector<double>{250}));
     EXPECT_DOUBLE_EQ(spec.outputs.average_from, 150);
   }
+  // Standard lowers the Mach number (TRT); thesis keeps the thesis's U = 0.1 with BGK.
+  const CaseSpec standard = load_case(cylinder_file, "standard");
+  EXPECT_EQ(standard.numerics.collision.op, CollisionSpec::Operator::trt);
+  EXPECT_DOUBLE_EQ(standard.numerics.lattice_velocity, 0.05);
+  const CaseSpec thesis = load_case(cylinder_file, "thesis");
+  EXPECT_EQ(thesis.numerics.collision.op, CollisionSpec::Operator::bgk);
+  EXPECT_DOUBLE_EQ(thesis.numerics.lattice_velocity, 0.1);
 }
 
-TEST(case_cylinder, QuickLevelCoarsensTheGridAndShortensTheRun) {
+TEST(case_cylinder, QuickLevelShortensTheRun) {
   const CaseSpec spec = load_case(cylinder_file, "quick");
   expect_cylinder_common(spec);
   EXPECT_EQ(spec.fidelity, "quick");
-  EXPECT_DOUBLE_EQ(spec.numerics.grid.fine_spacing, 0.04);
-  EXPECT_DOUBLE_EQ(spec.numerics.end_time, 150);
-  EXPECT_DOUBLE_EQ(spec.resolved["numerics"]["grid"]["fine_spacing"].get<double>(), 0.04);
+  EXPECT_DOUBLE_EQ(spec.numerics.grid.fine_spacing, 0.02);
+  EXPECT_DOUBLE_EQ(spec.numerics.end_time, 120);
+  EXPECT_DOUBLE_EQ(spec.resolved["numerics"]["end_time"].get<double>(), 120);
 }
 
 TEST(case_cylinder, ListsItsFidelityLevels) {
@@ -180,7 +185,7 @@ TEST(case_overrides, ApplyAfterTheFidelityLevelAndInOrder) {
   const CaseSpec spec = load_case(
       cylinder_file, "quick", {"numerics.end_time=200", "numerics.end_time=180"});
   EXPECT_DOUBLE_EQ(spec.numerics.end_time, 180);
-  EXPECT_DOUBLE_EQ(spec.numerics.grid.fine_spacing, 0.04);
+  EXPECT_DOUBLE_EQ(spec.outputs.average_from, 80);  // from the quick level
 }
 
 TEST(case_overrides, CreateOptionalKeysTheSchemaAllows) {
@@ -364,7 +369,7 @@ TEST(case_rejects, FineRegionPresenceMustMatchRefinement) {
 }
 
 TEST(case_rejects, MagicWithBgk) {
-  expect_set_rejected({"numerics.collision.magic=0.25"}, "/numerics/collision/magic",
+  expect_set_rejected({"numerics.collision.operator=bgk", "numerics.collision.magic=0.25"}, "/numerics/collision/magic",
                       {"applies only when /numerics/collision/operator is \"trt\"", "\"bgk\" here",
                        "set by --set numerics.collision.magic=0.25"});
 }
