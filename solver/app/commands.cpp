@@ -73,8 +73,9 @@ int run(const RunArgs& args, bool terminal) {
   if (args.threads > 0) spec_threads.numerics.threads = args.threads;
   fs::path out = args.out;
   if (out.empty()) {
-    std::string id = spec.id;
-    std::replace(id.begin(), id.end(), '/', '_');
+    // Same layout as scripts/reproduce: results/<fidelity>/<id with "/" as "__">.
+    std::string id;
+    for (char c : spec.id) id += c == '/' ? std::string("__") : std::string(1, c);
     out = fs::path("results") / spec.fidelity / id;
   }
   const auto units = sim::derive_units(spec_threads);
