@@ -25,7 +25,10 @@ class Fluid {
   static constexpr int D = L::d;
   using Pop = field::Populations<L, T>;
   using Force = field::VectorField<D, double>;
-  /// Fills the finest block's force density for its next step; returns false when there is none.
+  /// Adds the finest block's force density for its next step; returns false when there is none.
+  /// The field holds the uniform body force everywhere except at the nodes the hook changed
+  /// in its previous call, which the hook restores first: the IB touches only its stencils,
+  /// so nothing here sweeps the whole field every substep.
   using ForcingHook = std::function<bool(const Pop&, Force&)>;
 
   struct Block {
@@ -126,8 +129,10 @@ class Fluid {
     const std::size_t b = &blk - blocks_.data();
     bool forced = blk.has_body_force;
     if (hook) {
-      if (blk.force.comp[0].empty()) blk.force = Force(blk.pop.grid().size());
-      for (int a = 0; a < D; ++a) std::fill(blk.force.comp[a].begin(), blk.force.comp[a].end(), body_force_[b][a]);
+      if (blk.force.comp[0].empty()) {  // once: a hook on a block built without a force field
+        blk.force = Force(blk.pop.grid().size());
+        for (int a = 0; a < D; ++a) std::fill(blk.force.comp[a].begin(), blk.force.comp[a].end(), body_force_[b][a]);
+      }
       forced = hook(blk.pop, blk.force) || forced;
     }
     if (forced)

@@ -234,6 +234,17 @@ class Scene {
       return u;
     };
     auto rho = [&](const Index<D>&, std::ptrdiff_t n) { return collision::node_moments<L, T>(pop, n).rho; };
+    // Restore the nodes the bodies wrote last step to the uniform body force (see ForcingHook).
+    const auto& base = fluid_.body_force(fluid_.block_count() - 1);
+    for (auto& b : bodies_)
+      std::visit(
+          [&](auto& forcing) {
+            const auto& tr = forcing.transfer();
+            for (std::size_t m = 0; m < tr.marker_count(); ++m)
+              for (const auto node : tr.stencil_nodes(m))
+                for (int a = 0; a < D; ++a) f.comp[a][node] = base[a];
+          },
+          b.forcing);
     for (auto& b : bodies_) {
       try {
         std::visit(
