@@ -1,0 +1,45 @@
+#include "diagnostics/capsule_motion.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace caplab::diagnostics {
+
+double AngleUnwrapper::operator()(double angle) {
+  if (!started_) {
+    started_ = true;
+    return last_ = angle;
+  }
+  const double d = angle - last_;
+  return last_ += d - period_ * std::round(d / period_);
+}
+
+CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const double> inclination,
+                                      std::span<const double> phase, double t_from,
+                                      double oscillation_threshold) {
+  CAPLAB_CHECK(t.size() == inclination.size() && t.size() == phase.size(),
+               "capsule motion: time, inclination and phase need the same number of samples");
+  const std::size_t first = std::lower_bound(t.begin(), t.end(), t_from) - t.begin();
+  CAPLAB_CHECK(t.size() >= first + 3, "capsule motion: fewer than 3 samples after the start of the window");
+  const std::size_t last = t.size() - 1;
+
+  CapsuleMotion m;
+  const auto [lo_all, hi_all] = std::minmax_element(inclination.begin(), inclination.end());
+  m.inclination_turn = *hi_all - *lo_all;
+  const auto [lo, hi] = std::minmax_element(inclination.begin() + first, inclination.end());
+  m.inclination_amplitude = 0.5 * (*hi - *lo);
+  const double span = t[last] - t[first];
+  m.tank_treading_rate = std::abs(phase[last] - phase[first]) / span;
+  if (m.inclination_turn > std::numbers::pi) {
+    m.mode = "tumbling";
+    const double turn = std::abs(inclination[last] - inclination[first]);
+    if (turn > 0) m.tumbling_period = std::numbers::pi * span / turn;
+  } else {
+    m.mode = m.inclination_amplitude > oscillation_threshold ? "oscillating_tank_treading" : "steady_tank_treading";
+  }
+  return m;
+}
+
+}  // namespace caplab::diagnostics

@@ -1,0 +1,60 @@
+// Motion modes of a capsule in shear flow from its tracked inclination and membrane phase
+// (thesis ch. 3: steady tank-treading, tank-treading with oscillation, tumbling).
+//
+// Inputs are continuous (unwrapped) angles: the inclination theta(t) of the major axis of
+// the equivalent ellipse (defined modulo pi, unwrapped by AngleUnwrapper(pi)) and the phase
+// phi(t) of one tracked membrane node about the centroid (modulo 2 pi).
+//
+// Classification (times in 1/k):
+//   tumbling                   the inclination turns through more than pi over the run (the
+//                              thesis: "the oscillation amplitude is larger than pi", ch. 3.2.2);
+//   oscillating_tank_treading  otherwise, when (max - min)/2 of theta over t >= t_from exceeds
+//                              `oscillation_threshold` (default 1 degree);
+//   steady_tank_treading       otherwise.
+// Rates over the window t >= t_from: tank-treading angular rate |phi(end) - phi(from)| / (end - from)
+// (so T = 2 pi / rate, thesis ch. 3 f = 4 pi/(k T) = 2 rate/k, ch. 4 f/k = rate/k), and for a
+// tumbling capsule the period of a half-turn of theta, pi (end - from) / |theta(end) - theta(from)|
+// (Jeffery 1922: pi (1 + r^2)/r for a rigid ellipse of aspect ratio r, thesis eq. 3.11).
+#pragma once
+
+#include <numbers>
+#include <optional>
+#include <span>
+#include <string>
+
+namespace caplab::diagnostics {
+
+/// Turns a sequence of angles known modulo `period` into a continuous one: each value is the
+/// representative nearest to the previous one. Valid while consecutive samples move by less
+/// than period / 2.
+class AngleUnwrapper {
+ public:
+  explicit AngleUnwrapper(double period) : period_(period) {}
+  double operator()(double angle);
+  /// Forgets the history: the next value is taken as it is (e.g. while a shape is too round
+  /// for its axis to mean anything).
+  void reset() { started_ = false; }
+
+ private:
+  double period_;
+  double last_ = 0.0;
+  bool started_ = false;
+};
+
+struct CapsuleMotion {
+  std::string mode;                  ///< steady_tank_treading | oscillating_tank_treading | tumbling
+  double inclination_turn = 0;       ///< max - min of theta over the whole run (rad)
+  double inclination_amplitude = 0;  ///< (max - min)/2 of theta over the window (rad)
+  double tank_treading_rate = 0;     ///< |d phi/dt| averaged over the window (rad per 1/k)
+  std::optional<double> tumbling_period;  ///< time of a half-turn of theta (1/k), when tumbling
+};
+
+inline constexpr double default_oscillation_threshold = std::numbers::pi / 180;
+
+/// Classifies the motion from theta(t), phi(t) sampled at t (strictly increasing). Throws
+/// core::Error when fewer than 3 samples lie in t >= t_from or the lengths differ.
+CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const double> inclination,
+                                      std::span<const double> phase, double t_from,
+                                      double oscillation_threshold = default_oscillation_threshold);
+
+}  // namespace caplab::diagnostics
