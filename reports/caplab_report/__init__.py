@@ -7,7 +7,10 @@ base64 PNG) plus a PDF of each page printed by headless Chromium:
 
 - ``OUT/index.html`` (+ ``index.pdf``): every verdict of every chapter, environment;
 - ``OUT/chapterN/index.html`` (+ ``index.pdf``): per case title, description, time histories
-  with reference bands, scorecard, cost; for chapter 2 the thesis tables 2.1 and 2.2 reproduced;
+  with reference bands, scorecard, cost; for chapter 2 the thesis tables 2.1 and 2.2 reproduced
+  (cylinder.py); for capsule cases (capsule.py) the families overlaid like the thesis figures,
+  Jeffery's orbit, membrane contours, the thesis statements checked against the runs, and
+  self-convergence;
 - ``OUT/references.html``: the provenance of every reference dataset, with anchors.
 
 Runs that failed, diverged, never finished or are missing are shown as such, never omitted.

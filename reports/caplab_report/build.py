@@ -2,7 +2,8 @@
 
 Output (``out``):
     index.html, index.pdf            every chapter's verdicts, environment
-    chapterN/index.html, index.pdf   one chapter: cases, figures, scorecards, tables 2.1/2.2 (ch2)
+    chapterN/index.html, index.pdf   one chapter: cases, figures, scorecards, tables 2.1/2.2 (ch2),
+                                     capsule families, thesis statements, verification (capsule.py)
     references.html                  provenance of every reference dataset, with anchors
 
 Files are written to a temporary name and renamed, under an exclusive lock on ``out/.lock``, so
@@ -23,8 +24,8 @@ from pathlib import Path
 
 import jinja2
 
-from . import cylinder, figures
-from .references import KIND_LABELS, ReferenceLibrary
+from . import capsule, cylinder, figures
+from .references import KIND_LABELS, ReferenceLibrary, claim_summary, parameters_text
 from .runs import (Run, catalogue_cases, chapter_slug, chapter_sort_key, chapter_title, discover,
                    finite, with_missing)
 
@@ -66,11 +67,20 @@ def fmt_num(v, digits: int = 4) -> str:
 
 
 def fmt_error(v, comparison: str) -> str:
+    if comparison == "mode":
+        return {0: "match", 1: "mismatch"}.get(v, "–") if finite(v) else "–"
     if not finite(v):
         return fmt_num(v)
     if comparison == "relative":
         return f"{100 * float(v):.2f} %"
     return fmt_num(v)
+
+
+def fmt_modes(v) -> str:
+    """A mode entry's reference: a regime, or the allowed regimes joined by "or"."""
+    if isinstance(v, list):
+        return " or ".join(str(x) for x in v) or "–"
+    return "–" if v is None else str(v)
 
 
 def fmt_seconds(v) -> str:
@@ -106,6 +116,8 @@ def scorecard(run: Run, refs: ReferenceLibrary) -> list[dict]:
         ref_value = e.get("reference_value", a.get("reference_value"))
         if comparison == "bracket" and ref_value is None:
             ref_value = a.get("bracket")
+        if comparison == "mode" and ref_value is None:
+            ref_value = a.get("reference_mode")
         tolerance = e.get("tolerance")
         if tolerance is None:
             tolerance = figures.tolerance_at(a, run.fidelity)
@@ -119,12 +131,13 @@ def scorecard(run: Run, refs: ReferenceLibrary) -> list[dict]:
         rows.append({
             "metric": metric,
             "value": fmt_num(e.get("value"), 5) if e else "–",
-            "unit": "" if unit in ("1", "") else unit,
-            "reference_value": fmt_num(ref_value),
+            "unit": "" if unit in ("1", "-", "") or comparison == "mode" else unit,
+            "reference_value": fmt_modes(ref_value) if comparison == "mode" else fmt_num(ref_value),
             "reference": resolved,
             "comparison": comparison,
             "error": fmt_error(e.get("error"), comparison) if e else "–",
-            "tolerance": fmt_error(tolerance, comparison) if comparison in ("relative", "absolute") else fmt_num(tolerance),
+            "tolerance": ("exact" if comparison == "mode" else fmt_error(tolerance, comparison)
+                          if comparison in ("relative", "absolute") else fmt_num(tolerance)),
             "verdict": verdict,
             "justification": e.get("justification") or a.get("justification") or "",
             "message": e.get("message", ""),
@@ -265,7 +278,8 @@ def environment() -> jinja2.Environment:
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(str(TEMPLATES)),
                              autoescape=jinja2.select_autoescape(["html", "j2"]),
                              trim_blocks=True, lstrip_blocks=True)
-    env.filters.update(num=fmt_num, verdict=verdict_label, seconds=fmt_seconds,
+    env.filters.update(num=fmt_num, verdict=verdict_label, seconds=fmt_seconds, claim_summary=claim_summary,
+                       claim_parameters=parameters_text,
                        kind=lambda k: KIND_LABELS.get(k, {"caplab": "caplab run"}.get(k, k)))
     return env
 
@@ -311,6 +325,10 @@ def build_report(results: Path, out: Path, references: Path | None = None, catal
                     if ds is not None:
                         used[ds.anchor] = ds
             tables = cylinder.build(chapter_runs, refs) if chapter == "ch2" else None
+            capsules = capsule.build(chapter_runs, refs, chapter)
+            for ds in capsules.datasets:
+                used[ds.anchor] = ds
+            result.problems += [f"{chapter}: {p}" for p in capsules.problems]
             conventions = {}
             if tables is not None:
                 for name in ("table_2_1.csv", "table_2_2.csv", "cylinder_extra_reference_values.csv"):
@@ -327,7 +345,8 @@ def build_report(results: Path, out: Path, references: Path | None = None, catal
             html = env.get_template("chapter.html.j2").render(
                 title=f"caplab report — {chapter_title(chapter)}", chapter=chapter,
                 chapter_title=chapter_title(chapter), runs=chapter_runs, views=views, counts=counts(chapter_runs),
-                tables=tables, datasets=sorted(used.values(), key=lambda d: d.rel), conventions=conventions,
+                tables=tables, capsules=capsules, datasets=sorted(used.values(), key=lambda d: d.rel),
+                conventions=conventions,
                 builds=builds,
                 env_rows=env_rows, meta=meta, cost_figure=figures.cost_vs_error(chapter_runs),
                 problems=[p for p in refs.problems], root="../")

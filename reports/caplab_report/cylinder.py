@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .references import ReferenceLibrary
-from .runs import Run, finite
+from .runs import Run
 
 COLUMNS = ["cd_re100", "cl_re100", "st_re100", "cd_re200", "cl_re200", "st_re200"]
 METRICS = {
@@ -24,33 +24,21 @@ METRICS = {
 
 
 def is_fixed_cylinder(run: Run) -> bool:
-    phys = run.case.get("physics")
-    if not isinstance(phys, dict) or phys.get("dimension") != 2:
+    phys = run.physics
+    if phys.get("dimension") != 2:
         return False
     flow = phys.get("flow") if isinstance(phys.get("flow"), dict) else {}
-    bodies = phys.get("bodies") if isinstance(phys.get("bodies"), list) else []
-    if flow.get("type") != "uniform" or len(bodies) != 1 or not isinstance(bodies[0], dict):
+    bodies = run.bodies
+    if flow.get("type") != "uniform" or len(bodies) != 1 or "membrane" in bodies[0]:
         return False
     shape = bodies[0].get("shape") or {}
     motion = bodies[0].get("motion") or {"type": "fixed"}
     return shape.get("type") == "circle" and motion.get("type") == "fixed"
 
 
-def fine_spacing(run: Run):
-    numerics = run.case.get("numerics") if isinstance(run.case.get("numerics"), dict) else {}
-    grid = numerics.get("grid") if isinstance(numerics.get("grid"), dict) else {}
-    s = grid.get("fine_spacing")
-    return float(s) if finite(s) and s > 0 else None
-
-
 def _preference(run: Run):
-    spacing = fine_spacing(run)
+    spacing = run.fine_spacing
     return (run.status == "ok", -(spacing if spacing is not None else 1e9), run.case_id)
-
-
-def reynolds(run: Run):
-    r = run.case.get("physics", {}).get("reynolds")
-    return float(r) if finite(r) else None
 
 
 @dataclass
@@ -101,7 +89,7 @@ def build(runs: list[Run], refs: ReferenceLibrary) -> Tables:
     extra = refs.get("cylinder", "cylinder_extra_reference_values.csv")
     # Several runs of one Re and fidelity (e.g. a resolution sweep): the finished run on the finest
     # grid stands for it in table 2.1 (sorted so that it comes last and wins).
-    cyl = sorted((r for r in runs if is_fixed_cylinder(r) and reynolds(r) in (100.0, 200.0)), key=_preference)
+    cyl = sorted((r for r in runs if is_fixed_cylinder(r) and r.reynolds in (100.0, 200.0)), key=_preference)
 
     if t21 is None:
         tables.problems.append("references/cylinder/table_2_1.csv not found")
@@ -126,7 +114,7 @@ def build(runs: list[Run], refs: ReferenceLibrary) -> Tables:
             [Cell(f"{ranges[c][0]:g} – {ranges[c][1]:g}" if c in ranges else "–") for c in COLUMNS], css="range"))
         present = t21.row("Present")
         for fidelity in sorted({r.fidelity for r in cyl}):
-            by_re = {int(reynolds(r)): r for r in cyl if r.fidelity == fidelity}
+            by_re = {int(r.reynolds): r for r in cyl if r.fidelity == fidelity}
             cells = []
             for c in COLUMNS:
                 quantity, re_value = c[:2], int(c[-3:])
@@ -172,11 +160,11 @@ def build(runs: list[Run], refs: ReferenceLibrary) -> Tables:
                                                          Cell(t22.cell(r[0], "cd_re200") or "–")]))
         points: dict[tuple[str, int], dict[int, Run]] = {}
         for run in cyl:
-            spacing = fine_spacing(run)
+            spacing = run.fine_spacing
             if spacing is None:
                 continue
             n = int(round(1.0 / spacing))
-            points.setdefault((run.fidelity, n), {})[int(reynolds(run))] = run
+            points.setdefault((run.fidelity, n), {})[int(run.reynolds)] = run
         for (fidelity, n), by_re in sorted(points.items(), key=lambda kv: (kv[0][1], kv[0][0])):
             cells = [Cell(str(n))]
             for re_value in (100, 200):

@@ -5,6 +5,9 @@
   mean or final value, mean +- amplitude for an amplitude, band for a bracket, curve for a
   reference series) with its tolerance band at the run's fidelity; the averaging window shaded.
 - ``cost_vs_error``: wall time against relative error per scored metric (DESIGN.md section 7).
+
+Readers shared by the chapter modules: ``read_series`` (series.h5) and ``read_meshes``
+(the membrane meshes of snapshots.h5).
 """
 
 from __future__ import annotations
@@ -65,6 +68,44 @@ def read_series(path) -> tuple[Series | None, list[Series], str]:
             return t, cols, ""
     except Exception as err:  # h5py raises many types for a damaged file
         return None, [], f"series.h5 unreadable: {err}"
+
+
+@dataclass
+class Mesh:
+    """One Lagrangian mesh of snapshots.h5 at one output time (layout: solver/io/snapshot_writer.hpp)."""
+
+    time: float
+    name: str
+    points: np.ndarray        #: [N][3] (2D: z = 0)
+    connectivity: np.ndarray  #: [M][2] segments (2D ring) or [M][3] triangles
+
+
+def read_meshes(path) -> tuple[list[Mesh], str]:
+    """(meshes sorted by time, problem): every group /step_*/<name> holding "points" and
+    "connectivity"; grid blocks (which hold neither) are skipped."""
+    try:
+        import h5py
+    except ImportError as err:  # pragma: no cover - environment problem
+        return [], f"h5py not available: {err}"
+    meshes: list[Mesh] = []
+    try:
+        with h5py.File(path, "r") as f:
+            for step_name in f:
+                step = f[step_name]
+                if not step_name.startswith("step_") or not hasattr(step, "keys"):
+                    continue
+                time = np.asarray(step.attrs.get("time", [np.nan]), dtype=float).ravel()
+                for name in step:
+                    group = step[name]
+                    if not hasattr(group, "keys") or "points" not in group or "connectivity" not in group:
+                        continue
+                    meshes.append(Mesh(float(time[0]) if time.size else math.nan, name,
+                                       np.asarray(group["points"][()], dtype=float),
+                                       np.asarray(group["connectivity"][()], dtype=int)))
+    except Exception as err:  # h5py raises many types for a damaged file
+        return [], f"snapshots.h5 unreadable: {err}"
+    meshes.sort(key=lambda m: (m.name, m.time))
+    return meshes, "" if meshes else "snapshots.h5 holds no membrane mesh"
 
 
 def png_data_uri(fig) -> str:

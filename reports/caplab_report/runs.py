@@ -120,10 +120,47 @@ class Run:
 
     @property
     def series_path(self) -> Path | None:
+        return self._file("series.h5")
+
+    @property
+    def snapshots_path(self) -> Path | None:
+        return self._file("snapshots.h5")
+
+    def _file(self, name: str) -> Path | None:
         if self.directory is None:
             return None
-        p = self.directory / "series.h5"
+        p = self.directory / name
         return p if p.is_file() else None
+
+    # ---- the case (case.json, or the catalogue file of a missing run) ------------------------
+    @property
+    def physics(self) -> dict:
+        phys = self.case.get("physics")
+        return phys if isinstance(phys, dict) else {}
+
+    @property
+    def bodies(self) -> list[dict]:
+        bodies = self.physics.get("bodies")
+        return [b for b in bodies if isinstance(b, dict)] if isinstance(bodies, list) else []
+
+    @property
+    def reynolds(self) -> float | None:
+        r = self.physics.get("reynolds")
+        return float(r) if finite(r) else None
+
+    @property
+    def fine_spacing(self) -> float | None:
+        """numerics.grid.fine_spacing (in L), or None."""
+        numerics = self.case.get("numerics") if isinstance(self.case.get("numerics"), dict) else {}
+        grid = numerics.get("grid") if isinstance(numerics.get("grid"), dict) else {}
+        s = grid.get("fine_spacing")
+        return float(s) if finite(s) and s > 0 else None
+
+    def summary_value(self, name: str):
+        """The value of summary metric ``name`` as written (number, string, ...), or None."""
+        metrics = self.summary.get("metrics") if isinstance(self.summary, dict) else None
+        m = metrics.get(name) if isinstance(metrics, dict) else None
+        return m.get("value") if isinstance(m, dict) else m
 
     # ---- verdicts ---------------------------------------------------------------------------
     @property

@@ -92,8 +92,13 @@ int run(const RunArgs& args, bool terminal) {
   const auto r = sim::run_case(spec_threads, out, progress);
   if (terminal) fmt::print(stderr, "\n");
   fmt::print("ran {} steps in {} ({:.1f} MLUPS) -> {}\n", r.steps, human_seconds(r.wall_seconds), r.mlups, out.string());
-  for (const auto& [k, v] : r.summary["metrics"].items())
-    fmt::print("  {:34s} {:.6g}\n", k, v["value"].get<double>());
+  for (const auto& [k, v] : r.summary["metrics"].items()) {
+    const auto& value = v["value"];
+    if (value.is_string())
+      fmt::print("  {:34s} {}\n", k, value.get<std::string>());
+    else
+      fmt::print("  {:34s} {:.6g}\n", k, value.get<double>());
+  }
   return score(ScoreArgs{out, args.strict});
 }
 

@@ -10,6 +10,7 @@
 
 #include "case/case_diagnostics.hpp"
 #include "case/case_spec.hpp"
+#include "geometry/closed_curve.hpp"
 
 namespace caplab::cases {
 
@@ -21,6 +22,11 @@ inline constexpr double spacing_tolerance = 1e-9;
 inline constexpr int fine_region_margin_coarse = 4;
 /// Bodies keep this many fine spacings from the fine block faces (IB kernel support).
 inline constexpr int body_margin_fine = 3;
+/// Capsule membrane nodes at most this many fine spacings apart (beyond it the fluid leaks).
+inline constexpr double max_membrane_spacing_fine = 2.0;
+
+/// The rest shape of a 2D capsule as the geometry module describes it.
+geometry::RingShape ring_shape(const ShapeSpec& shape);
 
 /// Checks that every array listed in `per_axis_pointers` has `dimension` entries.
 void check_axis_lengths(const nlohmann::json& doc, int dimension,

@@ -34,7 +34,16 @@ inline constexpr std::array boundary_names{EnumName<BoundaryType>{"periodic", Bo
                                            EnumName<BoundaryType>{"wall", BoundaryType::wall}};
 
 inline constexpr std::array shape_type_names{EnumName<ShapeSpec::Type>{"circle", ShapeSpec::Type::circle},
+                                             EnumName<ShapeSpec::Type>{"ellipse", ShapeSpec::Type::ellipse},
+                                             EnumName<ShapeSpec::Type>{"biconcave", ShapeSpec::Type::biconcave},
                                              EnumName<ShapeSpec::Type>{"sphere", ShapeSpec::Type::sphere}};
+
+inline constexpr std::array membrane_law_names{EnumName<MembraneSpec::Law>{"hooke", MembraneSpec::Law::hooke}};
+
+inline constexpr std::array reference_curvature_names{
+    EnumName<MembraneSpec::ReferenceCurvature>{"initial", MembraneSpec::ReferenceCurvature::initial},
+    EnumName<MembraneSpec::ReferenceCurvature>{"circle", MembraneSpec::ReferenceCurvature::circle},
+    EnumName<MembraneSpec::ReferenceCurvature>{"flat", MembraneSpec::ReferenceCurvature::flat}};
 
 inline constexpr std::array motion_type_names{
     EnumName<RigidMotionSpec::Type>{"fixed", RigidMotionSpec::Type::fixed}};

@@ -71,14 +71,41 @@ constexpr Range positive{0, inf, true, false};
 constexpr Range at_least(double lo) { return {lo, inf, false, false}; }
 constexpr Range closed(double lo, double hi) { return {lo, hi, false, false}; }
 
+// ---- Acceptance entries whose keys depend on the comparison. ----
+
+/// The comparison of an acceptance entry whose reference is a flow regime, not a number.
+constexpr std::string_view mode_comparison = "mode";
+
+/// Allowed `acceptance[].comparison`: the numeric ones (case_enums.hpp) and "mode".
+std::vector<std::string> acceptance_comparisons() {
+  std::vector<std::string> names{comparison_names.begin(), comparison_names.end()};
+  names.emplace_back(mode_comparison);
+  return names;
+}
+
+/// The flow regimes a "reference_mode" may name: the values of the summary metric "mode".
+const std::vector<std::string>& mode_names() {
+  static const std::vector<std::string> names{"steady_tank_treading", "oscillating_tank_treading",
+                                              "tumbling"};
+  return names;
+}
+
 // ---- The format (DESIGN.md section 5). Units are in catalogue/schema.json. ----
 
 SchemaNode build_case_schema() {
+  // A rigid body has "motion", a capsule "membrane" (exactly one: case_consistency.cpp).
   const SchemaNode body = object({
       req("name", text()),
       req("shape", object({req("type", choice(enum_names(shape_type_names))),
-                           req("center", per_axis(number())), req("diameter", number(positive))})),
-      req("motion", object({req("type", choice(enum_names(motion_type_names)))})),
+                           req("center", per_axis(number())), req("diameter", number(positive)),
+                           opt("aspect_ratio", number(at_least(1))),  // ellipse only
+                           opt("alpha", number(positive)),            // biconcave only
+                           opt("angle", number())})),                 // 2D only
+      opt("motion", object({req("type", choice(enum_names(motion_type_names)))})),
+      opt("membrane", object({req("law", choice(enum_names(membrane_law_names))),
+                              req("capillary", number(positive)), opt("bending_ratio", number(at_least(0))),
+                              opt("reference_curvature", choice(enum_names(reference_curvature_names))),
+                              req("nodes", integer(closed(8, 1e6)))})),
   });
   const SchemaNode physics = object({
       req("dimension", integer(closed(2, 3))),
@@ -112,12 +139,15 @@ SchemaNode build_case_schema() {
           object({req("times", array_of(number(at_least(0)))), req("fields", array_of(text()))})),
       opt("average_from", number(at_least(0))),
   });
+  // Numeric comparisons need "reference_value" and "tolerance", "mode" needs "reference_mode"
+  // instead (a mode name or an array of them): check_acceptance_entries.
   const SchemaNode acceptance = object({
       req("metric", text()),
       req("reference", text()),
-      req("reference_value", number()),
-      req("comparison", choice({comparison_names.begin(), comparison_names.end()})),
-      req("tolerance", map_of(number(positive))),
+      opt("reference_value", number()),
+      opt("reference_mode", any()),
+      req("comparison", choice(acceptance_comparisons())),
+      opt("tolerance", map_of(number(positive))),
       req("justification", text()),
   });
   return object({
@@ -151,6 +181,50 @@ const std::vector<ConditionalKey>& conditional_keys() {
       {"/numerics/collision/magic", "/numerics/collision/operator", {"trt"}, false},
   };
   return rules;
+}
+
+// Per entry: a mode entry has "reference_mode" (a known mode or a non-empty array of them) and
+// no "reference_value" or "tolerance"; every other entry the reverse.
+void check_acceptance_entries(const json& doc, const CaseDiagnostics& diag) {
+  if (!doc.contains("acceptance")) return;
+  const SchemaNode& format = case_schema().member("acceptance")->node.element.front();
+  const std::string modes_expected =
+      "a mode name, one of " + quoted_list(mode_names()) + ", or a non-empty array of them";
+  const json& entries = doc.at("acceptance");
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const json& entry = entries[i];
+    const std::string at = child_pointer("/acceptance", i);
+    const std::string& comparison = entry.at("comparison").get_ref<const std::string&>();
+    const bool mode = comparison == mode_comparison;
+    const std::string when = at + "/comparison is \"" + comparison + "\"";
+    using Keys = std::vector<std::string>;
+    const Keys needed = mode ? Keys{"reference_mode"} : Keys{"reference_value", "tolerance"};
+    const Keys unused = mode ? Keys{"reference_value", "tolerance"} : Keys{"reference_mode"};
+    for (const auto& key : needed)
+      if (!entry.contains(key))
+        diag.fail_text(child_pointer(at, key), "nothing (required key \"" + key + "\" is missing)",
+                       (key == "reference_mode" ? modes_expected : format.member(key)->node.expected()) +
+                           ", which is required when " + when);
+    for (const auto& key : unused)
+      if (entry.contains(key))
+        diag.fail(child_pointer(at, key), entry.at(key),
+                  "no \"" + key + "\" key when " + when +
+                      (mode ? ": a mode is matched exactly against \"reference_mode\"; remove it"
+                            : ": \"reference_mode\" belongs to the comparison \"mode\"; remove it"));
+    if (!mode) continue;
+    const std::string pointer = child_pointer(at, "reference_mode");
+    const json& reference = entry.at("reference_mode");
+    if (!reference.is_string() && !(reference.is_array() && !reference.empty()))
+      diag.fail(pointer, reference, modes_expected);
+    const json listed = reference.is_array() ? reference : json::array({reference});
+    for (std::size_t k = 0; k < listed.size(); ++k) {
+      const std::string where = reference.is_array() ? child_pointer(pointer, k) : pointer;
+      if (!listed[k].is_string()) diag.fail(where, listed[k], modes_expected);
+      const std::string& name = listed[k].get_ref<const std::string&>();
+      if (std::find(mode_names().begin(), mode_names().end(), name) == mode_names().end())
+        diag.fail(where, listed[k], "one of " + quoted_list(mode_names()) + did_you_mean(name, mode_names()));
+    }
+  }
 }
 
 // ---- The walker. ----
@@ -354,6 +428,7 @@ void check_conditional_keys(const json& doc, const CaseDiagnostics& diag) {
                 "no \"" + key + "\" key: it applies only when " + when + ", and " + rule.controller +
                     " is \"" + control + "\" here; remove it or change " + rule.controller);
   }
+  check_acceptance_entries(doc, diag);
 }
 
 std::string apply_override(json& doc, std::string_view dotted, json value, const std::string& label,

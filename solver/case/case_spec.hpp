@@ -46,16 +46,36 @@ struct RigidMotionSpec {
 };
 
 struct ShapeSpec {
-  enum class Type { circle, sphere };
+  enum class Type { circle, ellipse, biconcave, sphere };
   Type type = Type::circle;
   std::vector<double> center;  ///< in L
-  double diameter = 1.0;       ///< in L
+  /// In L: the diameter of a circle or sphere; for the other shapes the equivalent diameter
+  /// 2 (area/pi)^(1/2) (thesis eq. 3.9), i.e. twice the equivalent radius.
+  double diameter = 1.0;
+  double aspect_ratio = 2.0;  ///< ellipse: semi-major over semi-minor axis (thesis ch. 3: 2)
+  double alpha = 1.39;        ///< biconcave: cell radius ratio of thesis eq. 3.12 (red cell 1.39)
+  double angle = 0.0;         ///< 2D shapes: rotation of the long axis from x, radians (counter-clockwise)
 };
 
+/// Elastic membrane of a capsule (thesis ch. 3, eq. 3.1-3.10). Moduli as dimensionless groups.
+struct MembraneSpec {
+  enum class Law { hooke };
+  enum class ReferenceCurvature { initial, circle, flat };
+  Law law = Law::hooke;
+  double capillary = 0.04;    ///< G = mu k a / E (eq. 3.9)
+  double bending_ratio = 0.0; ///< E_b = E_B / (a^2 E) (eq. 3.10)
+  ReferenceCurvature reference_curvature = ReferenceCurvature::initial;  ///< kappa_0 of eq. 3.8
+  int nodes = 160;            ///< Lagrangian nodes, equally spaced in arc length
+};
+
+/// A rigid body (with `motion`) or, when `membrane` is set, a liquid-filled capsule whose
+/// membrane moves with the fluid (thesis eq. 2.15).
 struct BodySpec {
   std::string name;
   ShapeSpec shape;
-  RigidMotionSpec motion;
+  std::optional<RigidMotionSpec> motion;   ///< rigid bodies
+  std::optional<MembraneSpec> membrane;   ///< capsules
+  bool is_capsule() const { return membrane.has_value(); }
 };
 
 struct PhysicsSpec {
@@ -120,8 +140,9 @@ struct AcceptanceSpec {
   std::string metric;         ///< a key of summary.json
   std::string reference;      ///< path of a references/ dataset (with #key) or "value"
   double reference_value = 0.0;
-  std::string comparison;     ///< "relative" | "absolute"
-  std::map<std::string, double> tolerance;  ///< per fidelity level
+  std::string comparison;     ///< "relative" | "absolute" | "mode"
+  std::map<std::string, double> tolerance;  ///< per fidelity level (numeric comparisons)
+  std::vector<std::string> reference_modes;   ///< comparison "mode": the allowed modes
   std::string justification;
 };
 

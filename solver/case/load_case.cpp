@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <set>
 
 #include "case/case_consistency.hpp"
@@ -147,7 +148,23 @@ CaseSpec to_spec(const json& doc) {
     body.shape.type = enum_value(shape_type_names, b.at("shape").at("type").get<std::string>());
     body.shape.center = b.at("shape").at("center").get<std::vector<double>>();
     body.shape.diameter = b.at("shape").at("diameter").get<double>();
-    body.motion.type = enum_value(motion_type_names, b.at("motion").at("type").get<std::string>());
+    body.shape.aspect_ratio = b.at("shape").value("aspect_ratio", body.shape.aspect_ratio);
+    body.shape.alpha = b.at("shape").value("alpha", body.shape.alpha);
+    body.shape.angle = b.at("shape").value("angle", body.shape.angle);
+    if (b.contains("motion"))
+      body.motion = RigidMotionSpec{enum_value(motion_type_names, b.at("motion").at("type").get<std::string>())};
+    if (b.contains("membrane")) {
+      const json& m = b.at("membrane");
+      MembraneSpec membrane;
+      membrane.law = enum_value(membrane_law_names, m.at("law").get<std::string>());
+      membrane.capillary = m.at("capillary").get<double>();
+      membrane.bending_ratio = m.value("bending_ratio", membrane.bending_ratio);
+      if (m.contains("reference_curvature"))
+        membrane.reference_curvature =
+            enum_value(reference_curvature_names, m.at("reference_curvature").get<std::string>());
+      membrane.nodes = m.at("nodes").get<int>();
+      body.membrane = membrane;
+    }
     physics.bodies.push_back(std::move(body));
   }
 
@@ -187,9 +204,14 @@ CaseSpec to_spec(const json& doc) {
     AcceptanceSpec entry;
     entry.metric = a.at("metric").get<std::string>();
     entry.reference = a.at("reference").get<std::string>();
-    entry.reference_value = a.at("reference_value").get<double>();
     entry.comparison = a.at("comparison").get<std::string>();
-    entry.tolerance = a.at("tolerance").get<std::map<std::string, double>>();
+    if (a.contains("reference_mode")) {
+      const json& m = a.at("reference_mode");
+      entry.reference_modes = m.is_array() ? m.get<std::vector<std::string>>() : std::vector<std::string>{m};
+    } else {
+      entry.reference_value = a.at("reference_value").get<double>();
+      entry.tolerance = a.at("tolerance").get<std::map<std::string, double>>();
+    }
     entry.justification = a.at("justification").get<std::string>();
     spec.acceptance.push_back(std::move(entry));
   }
@@ -217,6 +239,18 @@ void complete(CaseSpec& spec, json& resolved) {
                                 {"marker_spacing", numerics.ib.marker_spacing},
                                 {"forcing_iterations", numerics.ib.forcing_iterations}};
   resolved["numerics"]["threads"] = numerics.threads;
+  for (std::size_t i = 0; i < spec.physics.bodies.size(); ++i) {
+    const BodySpec& body = spec.physics.bodies[i];
+    json& b = resolved["physics"]["bodies"][i];
+    if (body.shape.type == ShapeSpec::Type::ellipse) b["shape"]["aspect_ratio"] = body.shape.aspect_ratio;
+    if (body.shape.type == ShapeSpec::Type::biconcave) b["shape"]["alpha"] = body.shape.alpha;
+    if (spec.physics.dimension == 2) b["shape"]["angle"] = body.shape.angle;
+    if (body.membrane) {
+      b["membrane"]["bending_ratio"] = body.membrane->bending_ratio;
+      b["membrane"]["reference_curvature"] =
+          enum_name(reference_curvature_names, body.membrane->reference_curvature);
+    }
+  }
   resolved["outputs"]["snapshots"] = {{"times", spec.outputs.snapshots.times},
                                       {"fields", spec.outputs.snapshots.fields}};
   resolved["outputs"]["average_from"] = spec.outputs.average_from;

@@ -37,7 +37,8 @@ CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const
     const double turn = std::abs(inclination[last] - inclination[first]);
     if (turn > 0) m.tumbling_period = std::numbers::pi * span / turn;
   } else {
-    m.mode = m.inclination_amplitude > oscillation_threshold ? "oscillating_tank_treading" : "steady_tank_treading";
+    m.mode = m.inclination_amplitude > oscillation_threshold ? "oscillating_tank_treading"
+                                                             : "steady_tank_treading";
   }
   return m;
 }

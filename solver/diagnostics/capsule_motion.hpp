@@ -42,10 +42,10 @@ class AngleUnwrapper {
 };
 
 struct CapsuleMotion {
-  std::string mode;                  ///< steady_tank_treading | oscillating_tank_treading | tumbling
-  double inclination_turn = 0;       ///< max - min of theta over the whole run (rad)
-  double inclination_amplitude = 0;  ///< (max - min)/2 of theta over the window (rad)
-  double tank_treading_rate = 0;     ///< |d phi/dt| averaged over the window (rad per 1/k)
+  std::string mode;                       ///< steady_tank_treading | oscillating_tank_treading | tumbling
+  double inclination_turn = 0;            ///< max - min of theta over the whole run (rad)
+  double inclination_amplitude = 0;       ///< (max - min)/2 of theta over the window (rad)
+  double tank_treading_rate = 0;          ///< |d phi/dt| averaged over the window (rad per 1/k)
   std::optional<double> tumbling_period;  ///< time of a half-turn of theta (1/k), when tumbling
 };
 

@@ -131,4 +131,16 @@ Comparison compare_time_series(const Series& run, const Series& reference, doubl
   }
 }
 
+Comparison compare_mode(std::string_view value, const std::vector<std::string>& allowed) {
+  if (allowed.empty()) return {kNaN, false, "no reference mode given"};
+  std::string listed;
+  for (const auto& mode : allowed) {
+    if (mode.empty()) return {kNaN, false, "a reference mode is an empty string"};
+    listed += (listed.empty() ? "\"" : " or \"") + mode + "\"";
+  }
+  if (value.empty()) return {kNaN, false, "the mode is an empty string; expected " + listed};
+  if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) return {0.0, true, ""};
+  return {1.0, false, fmt::format("mode \"{}\" is not the reference {}", value, listed)};
+}
+
 }  // namespace caplab::score

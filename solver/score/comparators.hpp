@@ -7,14 +7,19 @@
 //   time_series  error = RMS over the reference abscissae t_i in the overlap of the two series
 //                (and the optional window) of run(t_i) − ref(t_i), the run's series linearly
 //                interpolated onto t_i; passes when error ≤ tol.
+//   mode         a classification (e.g. the flow regime "tumbling"): error = 0 when the value
+//                is one of the allowed reference modes, 1 otherwise; passes when error is 0.
+//                A classification has no distance, so there is no tolerance.
 //
-// Invariants: a non-finite value, reference, tolerance or error never passes; a failing
-// comparison always carries a message saying why.
+// Invariants: a non-finite value, reference, tolerance or error never passes; an empty mode
+// name or an empty list of allowed modes never passes; a failing comparison always carries a
+// message saying why.
 #pragma once
 
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace caplab::score {
@@ -70,5 +75,9 @@ SeriesDistance rms_distance(const Series& run, const Series& reference,
 Comparison compare_time_series(const Series& run, const Series& reference, double tolerance,
                                const std::optional<Window>& window = std::nullopt,
                                SeriesDistance* detail = nullptr);
+
+/// `value` is one of `allowed` (exact, case-sensitive string match). Fails when `allowed` is
+/// empty or when `value` or one of `allowed` is an empty string.
+Comparison compare_mode(std::string_view value, const std::vector<std::string>& allowed);
 
 }  // namespace caplab::score

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -24,6 +25,7 @@ using json = nlohmann::json;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kComparisons = "relative, absolute, bracket, time_series or mode";
 
 /// A JSON file of the run directory: its content, or why it could not be read.
 struct JsonFile {
@@ -55,10 +57,23 @@ std::string joined_keys(const json& object) {
   return out.empty() ? "none" : out;
 }
 
-/// A metric of summary.json as a number: {"value": x, ...} or a bare number; NaN otherwise.
+/// The value of a metric of summary.json: `x` of {"value": x, ...}, or the metric itself.
+const json& metric_json(const json& metric) {
+  return metric.is_object() && metric.contains("value") ? metric["value"] : metric;
+}
+
+/// A metric of summary.json as a number; NaN when it is not a number.
 double metric_value(const json& metric) {
-  const json& v = metric.is_object() && metric.contains("value") ? metric["value"] : metric;
+  const json& v = metric_json(metric);
   return v.is_number() ? v.get<double>() : kNaN;
+}
+
+/// A metric is sane when it is a finite number or a non-empty string (a classification such
+/// as the flow regime "mode"); NaN (written as null), infinities, booleans and others are not.
+bool metric_is_sane(const json& metric) {
+  const json& v = metric_json(metric);
+  if (v.is_string()) return !v.get_ref<const std::string&>().empty();
+  return std::isfinite(metric_value(metric));
 }
 
 json check(const std::string& name, json value, json limit, bool pass, const std::string& message) {
@@ -90,12 +105,15 @@ json sanity_checks(const std::string& status, const JsonFile& summary) {
     std::string bad;
     int count = 0;
     for (const auto& [name, metric] : metrics.items())
-      if (!std::isfinite(metric_value(metric))) {
+      if (!metric_is_sane(metric)) {
         bad += (bad.empty() ? "" : ", ") + name;
         ++count;
       }
     checks.push_back(check("metrics_finite", count, 0, count == 0,
-                           count == 0 ? "" : "metrics not finite (NaN, infinite or not a number): " + bad));
+                           count == 0 ? ""
+                                      : "metrics not finite (NaN, infinite, or neither a number nor a "
+                                        "non-empty string): " +
+                                            bad));
   }
   const json sanity = doc.value("sanity", json::object());
   if (!sanity.is_object()) return checks;
@@ -200,16 +218,61 @@ double tolerance_for(const json& entry, const std::string& at, const Context& ct
   return tol[ctx.fidelity].get<double>();
 }
 
-/// Value and unit of a summary metric, or an EntryFailure naming the available metrics.
-double summary_metric(const std::string& metric, const Context& ctx, json& out) {
+/// A summary metric (its unit copied to `out`), or an EntryFailure naming the available metrics.
+const json& find_metric(const std::string& metric, const Context& ctx, json& out) {
   if (!ctx.metrics.contains(metric))
     throw EntryFailure{"metric " + metric + " not in summary.json (available: " + joined_keys(ctx.metrics) +
                        ")"};
   const json& m = ctx.metrics[metric];
   if (m.is_object() && m.contains("unit")) out["unit"] = m["unit"];
-  const double v = metric_value(m);
-  out["value"] = number_json(v);
-  return v;
+  return m;
+}
+
+/// Value and unit of a numeric summary metric; a string metric (a classification) is an
+/// EntryFailure that points to the mode comparison.
+double summary_metric(const std::string& metric, const std::string& comparison, const Context& ctx,
+                      json& out) {
+  const json& v = metric_json(find_metric(metric, ctx, out));
+  if (v.is_string()) {
+    out["value"] = v;
+    throw EntryFailure{fmt::format(
+        "metric {} is the string {}: a {} comparison needs a number (a classification is scored with "
+        "the comparison \"mode\")",
+        metric, v.dump(), comparison)};
+  }
+  const double value = metric_value(v);
+  out["value"] = number_json(value);
+  return value;
+}
+
+/// The allowed modes of a mode entry: "reference_mode" is a name or a non-empty array of names.
+std::vector<std::string> reference_modes(const json& entry, const std::string& at) {
+  const char* expected = "a mode name such as \"tumbling\" or a non-empty array of mode names";
+  if (!entry.contains("reference_mode"))
+    throw EntryFailure{fmt::format("{}/reference_mode is missing: expected {}", at, expected)};
+  const json& r = entry["reference_mode"];
+  std::vector<std::string> modes;
+  if (r.is_string()) modes.push_back(r.get<std::string>());
+  if (r.is_array())
+    for (const auto& m : r) modes.push_back(m.is_string() ? m.get<std::string>() : "");
+  const bool named = std::none_of(modes.begin(), modes.end(), [](const auto& m) { return m.empty(); });
+  if (modes.empty() || !named)
+    throw EntryFailure{fmt::format("{}/reference_mode is {}: expected {}", at, r.dump(), expected)};
+  return modes;
+}
+
+/// A mode entry: the summary metric's string against "reference_mode"; no tolerance (exact).
+Comparison score_mode(const json& entry, const std::string& at, const std::string& metric, const Context& ctx,
+                      json& out) {
+  const std::vector<std::string> modes = reference_modes(entry, at);
+  out["reference_value"] = entry["reference_mode"];
+  const json& v = metric_json(find_metric(metric, ctx, out));
+  out["value"] = v;
+  if (!v.is_string())
+    throw EntryFailure{
+        fmt::format("metric {} is {}: a mode comparison needs a string naming a mode (e.g. \"tumbling\")",
+                    metric, v.is_number() ? "the number " + v.dump() : v.dump())};
+  return compare_mode(v.get<std::string>(), modes);
 }
 
 Series series_from_json(const json& s, const std::string& at) {
@@ -284,14 +347,13 @@ json score_entry(const json& entry, std::size_t index, Context& ctx) {
     const std::string metric =
         require(entry, at, "metric", json::value_t::string, "a metric name").get<std::string>();
     const std::string comparison =
-        require(entry, at, "comparison", json::value_t::string, "relative, absolute, bracket or time_series")
-            .get<std::string>();
+        require(entry, at, "comparison", json::value_t::string, kComparisons).get<std::string>();
     Comparison c;
     if (comparison == "relative" || comparison == "absolute") {
       const double reference =
           require(entry, at, "reference_value", json::value_t::number_float, "a number").get<double>();
       out["reference_value"] = reference;
-      const double value = summary_metric(metric, ctx, out);
+      const double value = summary_metric(metric, comparison, ctx, out);
       const double tolerance = tolerance_for(entry, at, ctx, false);
       out["tolerance"] = tolerance;
       c = comparison == "relative" ? compare_relative(value, reference, tolerance)
@@ -301,15 +363,16 @@ json score_entry(const json& entry, std::size_t index, Context& ctx) {
       if (b.size() != 2 || !b[0].is_number() || !b[1].is_number())
         throw EntryFailure{at + "/bracket is " + b.dump() + ": expected [lo, hi]"};
       out["reference_value"] = b;
-      const double value = summary_metric(metric, ctx, out);
+      const double value = summary_metric(metric, comparison, ctx, out);
       const double margin = tolerance_for(entry, at, ctx, true);
       out["tolerance"] = margin;
       c = compare_bracket(value, b[0].get<double>(), b[1].get<double>(), margin);
     } else if (comparison == "time_series") {
       c = score_time_series(entry, at, ctx, out);
+    } else if (comparison == "mode") {
+      c = score_mode(entry, at, metric, ctx, out);
     } else {
-      throw EntryFailure{at + "/comparison is \"" + comparison +
-                         "\": expected relative, absolute, bracket or time_series"};
+      throw EntryFailure{at + "/comparison is \"" + comparison + "\": expected " + kComparisons};
     }
     out["error"] = number_json(c.error);
     out["verdict"] = c.pass ? "pass" : "fail";

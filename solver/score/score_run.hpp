@@ -3,8 +3,9 @@
 // [--strict]`, and read back (score.json) by the reports.
 //
 // Three separate verdicts:
-//  - sanity: did it run correctly — manifest status "ok", every metric of summary.json finite,
-//    every boolean of summary.json "sanity" true, |mass_drift| < 1e-3 when present;
+//  - sanity: did it run correctly — manifest status "ok", every metric of summary.json a
+//    finite number or a non-empty string (a classification such as "mode"), every boolean of
+//    summary.json "sanity" true, |mass_drift| < 1e-3 when present;
 //  - accuracy: each acceptance entry of case.json compared with its reference at the run's
 //    fidelity level (comparators.hpp); "none" (with a reason) for a run that is not "ok" or a
 //    case without acceptance entries;
@@ -21,6 +22,10 @@
 //                 "reference_series": {"t": [...], "value": [...]} or the CSV named by
 //                 "reference" ("file.csv#t_column:value_column", see reference_series.hpp);
 //                 optional "window": [from, to] (e.g. after the transient)
+//   mode:         "reference_mode": a mode name or an array of allowed names (e.g. "tumbling",
+//                 ["steady_tank_treading", "oscillating_tank_treading"]); "metric" is a key of
+//                 summary.json "metrics" whose value is a string; no "tolerance" (exact match);
+//                 "reference" names the statement, e.g. "references/capsule2d/claims.json#<id>"
 //
 // score.json layout:
 //   {"case_id", "fidelity",
@@ -30,7 +35,9 @@
 //                 "justification","verdict","message"?, "compared"?: {"from","to","points"}}]},
 //    "performance": {"wall_time_s","mlups","steps"}, "verdict": pass|fail}
 // A number that is not finite is written as null. For bracket entries "reference_value" is
-// [lo, hi]; for time_series entries "value" and "reference_value" are null.
+// [lo, hi]; for time_series entries "value" and "reference_value" are null; for mode entries
+// "value" is the metric's string, "reference_value" is "reference_mode" as written (a string or
+// an array of strings), "error" is 0 (one of the reference modes) or 1, "tolerance" is null.
 #pragma once
 
 #include <filesystem>

@@ -26,6 +26,14 @@ std::string text(const json& j) {
   return j.dump();
 }
 
+/// The reference of a mode entry: one name, or the allowed names joined by " or ".
+std::string modes_text(const json& j) {
+  if (!j.is_array() || j.empty()) return text(j);
+  std::string out;
+  for (const auto& m : j) out += (out.empty() ? "" : " or ") + text(m);
+  return out;
+}
+
 std::string percent_or_text(const json& j, bool relative) {
   if (relative && j.is_number()) return fmt::format("{:.3g}%", 100.0 * j.get<double>());
   return text(j);
@@ -62,6 +70,7 @@ std::string format_scorecard(const json& score) {
         value += fmt::format(" {}", field(e, "unit").get<std::string>());
       std::string reference =
           field(e, "comparison") == "time_series" ? "series" : text(field(e, "reference_value"));
+      if (field(e, "comparison") == "mode") reference = modes_text(field(e, "reference_value"));
       rows.push_back({text(field(e, "metric")), value, reference,
                       percent_or_text(field(e, "error"), relative),
                       percent_or_text(field(e, "tolerance"), relative), text(field(e, "verdict"))});

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <functional>
 #include <optional>
+#include <span>
 
 #include "boundary/boundary_set.hpp"
 #include "core/timing.hpp"
@@ -25,11 +26,13 @@ class Fluid {
   static constexpr int D = L::d;
   using Pop = field::Populations<L, T>;
   using Force = field::VectorField<D, double>;
-  /// Adds the finest block's force density for its next step; returns false when there is none.
-  /// The field holds the uniform body force everywhere except at the nodes the hook changed
-  /// in its previous call, which the hook restores first: the IB touches only its stencils,
-  /// so nothing here sweeps the whole field every substep.
-  using ForcingHook = std::function<bool(const Pop&, Force&)>;
+  /// Adds the finest block's force density for its next step and returns the nodes where the
+  /// field now differs from the uniform body force (empty: none). The field holds the uniform
+  /// body force everywhere except at the nodes the hook changed in its previous call, which
+  /// the hook restores first: the IB touches only its stencils, so nothing here sweeps the
+  /// whole field every substep. Without a uniform body force only the returned nodes take the
+  /// forced kernel (collide_forced_at); with one, the whole block does.
+  using ForcingHook = std::function<std::span<const std::ptrdiff_t>(const Pop&, Force&)>;
 
   struct Block {
     Pop pop;
@@ -127,18 +130,20 @@ class Fluid {
   template <class Boundaries>
   void advance_block(Block& blk, const ForcingHook& hook, Boundaries&& apply_boundaries) {
     const std::size_t b = &blk - blocks_.data();
-    bool forced = blk.has_body_force;
+    std::span<const std::ptrdiff_t> forced_nodes;
     if (hook) {
       if (blk.force.comp[0].empty()) {  // once: a hook on a block built without a force field
         blk.force = Force(blk.pop.grid().size());
         for (int a = 0; a < D; ++a) std::fill(blk.force.comp[a].begin(), blk.force.comp[a].end(), body_force_[b][a]);
       }
-      forced = hook(blk.pop, blk.force) || forced;
+      forced_nodes = hook(blk.pop, blk.force);
     }
-    if (forced)
+    if (blk.has_body_force) {
       collision::stream_collide<true>(blk.pop, blk.op, &blk.force);
-    else
+    } else {
       collision::stream_collide<false>(blk.pop, blk.op);
+      if (!forced_nodes.empty()) collision::collide_forced_at(blk.pop, blk.op, blk.force, forced_nodes);
+    }
     apply_boundaries();
     blk.pop.swap();
   }

@@ -7,10 +7,12 @@
 // fine substep the IB stage (direct forcing on the finest block from its force-free
 // velocity) followed by the forced collide-push and the coupled ghost ring; restriction.
 // Forces on bodies: minus the force they spread (Newton's third law); fixed bodies need no
-// internal-mass correction.
+// internal-mass correction. Capsules (sim/capsule.hpp) spread their membrane force after the
+// rigid bodies and then move with the velocity of the whole force field.
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <fmt/format.h>
 
@@ -20,12 +22,18 @@
 #include "case/case_spec.hpp"
 #include "core/error.hpp"
 #include "core/timing.hpp"
+#include "case/case_consistency.hpp"
+#include "diagnostics/capsule_motion.hpp"
+#include "diagnostics/shape2d.hpp"
 #include "diagnostics/signal.hpp"
+#include "geometry/closed_curve.hpp"
 #include "geometry/marker_set.hpp"
 #include "ibm/direct_forcing.hpp"
 #include "io/run_directory.hpp"
 #include "io/series_writer.hpp"
 #include "io/snapshot_writer.hpp"
+#include "membrane/ring_membrane.hpp"
+#include "sim/capsule.hpp"
 #include "sim/fluid.hpp"
 #include "sim/units.hpp"
 
@@ -86,6 +94,7 @@ class Scene {
       step_ = step;
       core::timed(seconds_fluid_, [&] { fluid_.step(hook); });
       const double t = step * dt;
+      if (!capsules_.empty()) core::timed(seconds_diagnostics_, [&] { track_capsules(); });
       if (step % guard_every == 0 || step == total) core::timed(seconds_diagnostics_, [&] { check_guards(step); });
       if (step % sample_every == 0 || step == total) {
         core::timed(seconds_diagnostics_, [&] { sample(t, row); });
@@ -112,10 +121,10 @@ class Scene {
     r.mlups = fluid_.updates_per_step() * total / r.wall_seconds / 1e6;
     const double coupling = fluid_.coupling_seconds();
     // The IB hook runs inside the fluid step: report it apart from the fluid update.
-    r.stage_seconds = {{"fluid", seconds_fluid_ - coupling - seconds_ib_},
+    r.stage_seconds = {{"fluid", seconds_fluid_ - coupling - seconds_ib_ - seconds_membrane_},
                        {"coupling", coupling},
                        {"ib", seconds_ib_},
-                       {"membrane", 0.0},
+                       {"membrane", seconds_membrane_},
                        {"diagnostics", seconds_diagnostics_},
                        {"output", seconds_output_}};
     r.summary = summarise(dir);
@@ -170,6 +179,10 @@ class Scene {
     const double h = fine.dx();
     const double spacing = spec_.numerics.ib.marker_spacing * h;
     for (const auto& b : spec_.physics.bodies) {
+      if (b.is_capsule()) {
+        build_capsule(b);
+        continue;
+      }
       RigidBody body{b.name, b.shape, {}, {}, {}, make_forcing(), Vec<D>::Zero(), 1.0};
       Vec<D> c;
       for (int a = 0; a < D; ++a) c[a] = b.shape.center[a];
@@ -189,6 +202,61 @@ class Scene {
       periodic_.fill(false);
     } else {
       for (int a = 0; a < D; ++a) periodic_[a] = spec_.physics.boundaries[a] == cases::BoundaryType::periodic;
+    }
+  }
+
+  void build_capsule(const cases::BodySpec& b) {
+    const auto& m = *b.membrane;
+    const double a = 0.5 * b.shape.diameter;  // equivalent radius, in L
+    // Moduli in lattice units of the finest block: E = mu k a / G with mu = rho nu (rho = 1)
+    // and k a = U (the lattice velocity); E_B = E_b a^2 E with a in L (positions are in L).
+    const double E = units_.blocks.back().nu_lu * units_.velocity_lu / m.capillary;
+    const double E_B = m.bending_ratio * a * a * E;
+    if constexpr (D == 2) {
+      Vec<2> c(b.shape.center[0], b.shape.center[1]);
+      auto rest = geometry::ring_nodes(cases::ring_shape(b.shape), c, a, b.shape.angle, m.nodes);
+      auto kappa0 = membrane::ReferenceCurvature::initial;
+      if (m.reference_curvature == cases::MembraneSpec::ReferenceCurvature::circle)
+        kappa0 = membrane::ReferenceCurvature::circle;
+      else if (m.reference_curvature == cases::MembraneSpec::ReferenceCurvature::flat)
+        kappa0 = membrane::ReferenceCurvature::flat;
+      auto ring = std::make_unique<membrane::RingMembrane>(rest, E, E_B, kappa0);
+      capsules_.emplace_back(b.name, std::move(rest), std::move(ring), make_transfer());
+      CapsuleTrack track;
+      const auto shape = diagnostics::equivalent_ellipse(capsules_.back().positions());
+      track.area0 = shape.area;
+      track.shape = shape;
+      capsule_tracks_.push_back(track);
+      track_capsules();
+    } else {
+      throw core::InputError(spec_.source_file, "/physics/bodies", b.name,
+                             "a capsule in 2D (3D membranes are not implemented yet)");
+    }
+  }
+
+  typename Capsule<D>::Transfers make_transfer() const {
+    switch (spec_.numerics.ib.kernel) {
+      case cases::IbSpec::Kernel::roma3: return ibm::Transfer<D, ibm::Roma3>();
+      case cases::IbSpec::Kernel::linear2: return ibm::Transfer<D, ibm::Linear2>();
+      default: return ibm::Transfer<D, ibm::Cosine4>();
+    }
+  }
+
+  /// Shape of each capsule after a step: equivalent ellipse, continuous inclination and
+  /// membrane phase (unwrapped every coarse step, so tumbling is followed at any sampling).
+  void track_capsules() {
+    if constexpr (D == 2) {
+      for (std::size_t c = 0; c < capsules_.size(); ++c) {
+        auto& tr = capsule_tracks_[c];
+        const auto X = capsules_[c].positions();
+        tr.shape = diagnostics::equivalent_ellipse(X);
+        // The axis of a nearly round capsule means nothing: follow it only once D_xy says
+        // there is one (an initially circular capsule starts at D = 0).
+        if (tr.shape.taylor < round_capsule_taylor) tr.inclination.reset();
+        tr.theta = tr.inclination(tr.shape.inclination);
+        const Vec<2> r = X[0] - tr.shape.centroid;
+        tr.phi = tr.phase(std::atan2(r[1], r[0]));
+      }
     }
   }
 
@@ -220,10 +288,86 @@ class Scene {
   }
 
   /// The IB stage of one finest-block step: adds the bodies' force density to f.
-  bool apply_ib(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
-    if (bodies_.empty()) return false;
-    core::timed(seconds_ib_, [&] { force_bodies(pop, f); });
-    return true;
+  /// Returns the nodes where it wrote a force (the union of the stencils, see ForcingHook).
+  std::span<const std::ptrdiff_t> apply_ib(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
+    if (bodies_.empty() && capsules_.empty()) return {};
+    if (!bodies_.empty()) core::timed(seconds_ib_, [&] { force_bodies(pop, f); });
+    if (!capsules_.empty()) move_capsules(pop, f);
+    core::timed(seconds_ib_, [&] {
+      if (capsules_.empty()) collect_forced_nodes(pop.grid().size());  // move_capsules collected them
+    });
+    return forced_nodes_;
+  }
+
+  /// forced_nodes_ = the union of the current stencils of all bodies and capsules, each node
+  /// once (a stamp per node instead of sorting); slot_[n] is the position of node n in it.
+  void collect_forced_nodes(std::ptrdiff_t grid_size) {
+    if (static_cast<std::ptrdiff_t>(slot_.size()) != grid_size) {
+      slot_.assign(grid_size, 0);
+      stamp_.assign(grid_size, 0);
+    }
+    if (++stamp_now_ == 0) {  // wrapped after 2^32 steps: start the stamps afresh
+      std::fill(stamp_.begin(), stamp_.end(), 0u);
+      stamp_now_ = 1;
+    }
+    forced_nodes_.clear();
+    auto add = [&](std::ptrdiff_t n) {
+      if (stamp_[n] == stamp_now_) return;
+      stamp_[n] = stamp_now_;
+      slot_[n] = static_cast<std::int32_t>(forced_nodes_.size());
+      forced_nodes_.push_back(n);
+    };
+    for (const auto& b : bodies_)
+      std::visit(
+          [&](const auto& forcing) {
+            const auto& tr = forcing.transfer();
+            for (std::size_t m = 0; m < tr.marker_count(); ++m)
+              for (const auto n : tr.stencil_nodes(m)) add(n);
+          },
+          b.forcing);
+    for (const auto& c : capsules_) c.for_each_stencil_node(add);
+  }
+
+  /// Membrane forces, spreading, and the markers' move with the forced velocity (capsule.hpp).
+  void move_capsules(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
+    const auto& base = fluid_.body_force(fluid_.block_count() - 1);
+    core::timed(seconds_membrane_, [&] {
+      for (auto& c : capsules_) c.compute_forces();
+    });
+    core::timed(seconds_ib_, [&] {
+      for (auto& c : capsules_) {
+        if (bodies_.empty()) c.restore(f, base);  // with rigid bodies, force_bodies restored the field
+        guarded(c.name(), [&] { c.spread(pop.grid(), periodic_, f); });
+      }
+      // The velocity the forced collision uses, once per stencil node (stencils overlap).
+      collect_forced_nodes(pop.grid().size());
+      velocity_.resize(forced_nodes_.size());
+      const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(forced_nodes_.size());
+#pragma omp parallel for schedule(static) if (count > 256)
+      for (std::ptrdiff_t k = 0; k < count; ++k) {
+        const std::ptrdiff_t n = forced_nodes_[k];
+        const auto m = collision::node_moments<L, T>(pop, n);
+        for (int a = 0; a < D; ++a) velocity_[k][a] = m.u[a] + f.comp[a][n] / (2.0 * m.rho);
+      }
+      auto velocity = [&](const Index<D>&, std::ptrdiff_t n) { return velocity_[slot_[n]]; };
+      for (auto& c : capsules_) c.advect(velocity, pop.grid().dx());
+    });
+  }
+
+  /// Runs f(); a core::Error from the IB stage (a stencil off the block, a non-finite
+  /// position) becomes a NumericalError naming the body, the step and the likely cause.
+  template <class F>
+  void guarded(const std::string& body, F&& f) const {
+    try {
+      f();
+    } catch (const core::NumericalError&) {
+      throw;
+    } catch (const core::Error& e) {
+      throw core::NumericalError(step_, fmt::format("immersed boundary of body '{}'", body), e.what(),
+                                 "the membrane left the fine block or its nodes diverged: enlarge the fine "
+                                 "region, lower the capillary number G or the time step (numerics.lattice_velocity), "
+                                 "or use more membrane nodes");
+    }
   }
 
   void force_bodies(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
@@ -245,6 +389,7 @@ class Scene {
                 for (int a = 0; a < D; ++a) f.comp[a][node] = base[a];
           },
           b.forcing);
+    for (const auto& c : capsules_) c.restore(f, base);
     for (auto& b : bodies_) {
       try {
         std::visit(
@@ -287,15 +432,46 @@ class Scene {
           columns_.push_back({many ? b.name + "." + q : q, "1",
                               q == "drag_coefficient" ? "C_d = F_drag / (0.5 rho U^2 D) (per unit span in 2D; area pi D^2/4 in 3D)"
                                                       : "C_l = F_lift / (0.5 rho U^2 D) (per unit span in 2D; area pi D^2/4 in 3D)"});
+      } else if (is_capsule_quantity(q)) {
+        if (capsules_.empty())
+          throw core::InputError(spec_.source_file, "/outputs/series/quantities", q,
+                                 "a quantity of a scene with capsules (this case has none)");
+        for (const auto& c : capsules_)
+          columns_.push_back({capsules_.size() > 1 ? c.name() + "." + q : q, capsule_unit(q), capsule_definition(q)});
       } else if (q == "mass") {
         columns_.push_back({"mass", "1", "total fluid mass over its initial value"});
       } else if (q == "kinetic_energy") {
         columns_.push_back({"kinetic_energy", "rho U^2 L^D", "integral of rho u^2 / 2 over the domain"});
       } else {
         throw core::InputError(spec_.source_file, "/outputs/series/quantities", q,
-                               "one of drag_coefficient, lift_coefficient, mass, kinetic_energy");
+                               "one of drag_coefficient, lift_coefficient, taylor_deformation, inclination, "
+                               "area_change, tank_treading_phase, mass, kinetic_energy");
       }
     }
+  }
+
+  static bool is_capsule_quantity(const std::string& q) {
+    return q == "taylor_deformation" || q == "inclination" || q == "area_change" || q == "tank_treading_phase";
+  }
+  static std::string capsule_unit(const std::string& q) {
+    return q == "inclination" || q == "tank_treading_phase" ? "rad" : "1";
+  }
+  static std::string capsule_definition(const std::string& q) {
+    if (q == "taylor_deformation")
+      return "D_xy = (L - B)/(L + B), L, B semi-axes of the ellipse with the inertia tensor of the enclosed area "
+             "(thesis eq. 2.33)";
+    if (q == "inclination")
+      return "angle of the major axis of that ellipse from the x axis, continuous in time (tumbling keeps "
+             "decreasing); counter-clockwise positive";
+    if (q == "area_change") return "enclosed area over its initial value, minus 1";
+    return "angle of membrane node 0 about the centroid, continuous in time (tank-treading: decreasing)";
+  }
+  double capsule_value(std::size_t c, const std::string& q) const {
+    const auto& tr = capsule_tracks_[c];
+    if (q == "taylor_deformation") return tr.shape.taylor;
+    if (q == "inclination") return tr.theta;
+    if (q == "area_change") return tr.shape.area / tr.area0 - 1.0;
+    return tr.phi;
   }
 
   void sample(double t, std::vector<double>& row) {
@@ -307,6 +483,8 @@ class Scene {
           const auto [cd, cl] = coefficients(b);
           row[k++] = q == "drag_coefficient" ? cd : cl;
         }
+      } else if (is_capsule_quantity(q)) {
+        for (std::size_t c = 0; c < capsules_.size(); ++c) row[k++] = capsule_value(c, q);
       } else if (q == "mass") {
         row[k++] = total_mass() / mass0_;
       } else if (q == "kinetic_energy") {
@@ -432,6 +610,10 @@ class Scene {
         const auto segs = io::closed_ring_segments(static_cast<int>(b.markers.X.size()));
         w.add_mesh_step(t, b.name, b.markers.X, segs);
       }
+      for (const auto& c : capsules_) {
+        const auto segs = io::closed_ring_segments(static_cast<int>(c.positions().size()));
+        w.add_mesh_step(t, c.name(), c.positions(), segs);
+      }
     }
   }
 
@@ -463,20 +645,95 @@ class Scene {
             {"definition", fmt::format("St = f D / U, f from {} periods of the lift signal", s.periods) + window}};
       }
     }
+    for (const auto& c : capsules_) summarise_capsule(c.name(), series, metrics);
     nlohmann::json sanity = {{"finite", true}};
     if (series.count("mass")) sanity["mass_drift"] = std::abs(series.at("mass").back() - 1.0);
     return {{"case_id", spec_.id}, {"fidelity", spec_.fidelity}, {"metrics", metrics}, {"sanity", sanity}};
   }
 
+  /// Capsule metrics from its series columns: D_xy and inclination statistics, the largest
+  /// area change, and the motion mode with its rates (diagnostics/capsule_motion.hpp).
+  void summarise_capsule(const std::string& name, const std::map<std::string, std::vector<double>>& series,
+                         nlohmann::json& metrics) const {
+    const std::string prefix = capsules_.size() > 1 ? name + "." : "";
+    const double from = spec_.outputs.average_from;
+    const std::string window = fmt::format(" over k t >= {}", from);
+    const auto& t = series.at("t");
+    auto column = [&](const std::string& q) -> const std::vector<double>* {
+      const auto it = series.find(prefix + q);
+      return it == series.end() ? nullptr : &it->second;
+    };
+    for (const char* q : {"taylor_deformation", "inclination"}) {
+      const auto* v = column(q);
+      if (!v) continue;
+      const auto s = diagnostics::analyse_signal(t, *v, from);
+      const std::string unit = capsule_unit(q);
+      metrics[prefix + q + "_mean"] = {{"value", s.mean}, {"unit", unit}, {"definition", "time average" + window}};
+      metrics[prefix + q + "_amplitude"] = {{"value", s.amplitude}, {"unit", unit}, {"definition", "(max - min)/2" + window}};
+    }
+    if (const auto* v = column("area_change")) {
+      double worst = 0;
+      for (double x : *v) worst = std::max(worst, std::abs(x));
+      metrics[prefix + "area_change_max"] = {
+          {"value", worst}, {"unit", "1"}, {"definition", "largest |A/A0 - 1| of the enclosed area over the run"}};
+    }
+    const auto* theta = column("inclination");
+    const auto* phi = column("tank_treading_phase");
+    if (!theta || !phi) return;
+    const auto motion = diagnostics::classify_capsule_motion(t, *theta, *phi, from);
+    metrics[prefix + "mode"] = {
+        {"value", motion.mode},
+        {"unit", ""},
+        {"definition", fmt::format("tumbling when the inclination turns through more than pi over the run (it "
+                                   "turned {:.3f} rad); else oscillating_tank_treading when its (max - min)/2{} "
+                                   "exceeds 1 degree (it is {:.4f} rad), else steady_tank_treading",
+                                   motion.inclination_turn, window, motion.inclination_amplitude)}};
+    if (motion.mode == "tumbling") {
+      if (motion.tumbling_period)
+        metrics[prefix + "tumbling_period"] = {
+            {"value", *motion.tumbling_period},
+            {"unit", "1/k"},
+            {"definition", "time for the inclination to turn through pi, averaged" + window}};
+    } else {
+      metrics[prefix + "tank_treading_frequency"] = {
+          {"value", 2.0 * motion.tank_treading_rate},
+          {"unit", "1"},
+          {"definition", "f = 4 pi / (k T), T the period of membrane node 0 about the centroid" + window +
+                             " (thesis ch. 3 normalisation; 1 for a rigid circle rotating at k/2)"}};
+      metrics[prefix + "tank_treading_frequency_per_k"] = {
+          {"value", motion.tank_treading_rate},
+          {"unit", "1"},
+          {"definition", "f / k = 2 pi / (k T)" + window + " (thesis ch. 4 normalisation)"}};
+    }
+  }
+
+  struct CapsuleTrack {
+    diagnostics::EquivalentEllipse shape;
+    diagnostics::AngleUnwrapper inclination{std::numbers::pi}, phase{2 * std::numbers::pi};
+    double area0 = 1.0;
+    double theta = 0.0, phi = 0.0;
+  };
+  /// Below this D_xy an initially circular capsule has no axis worth following.
+  static constexpr double round_capsule_taylor = 1e-4;
+
   const cases::CaseSpec& spec_;
   LatticeUnits units_;
   FluidT fluid_;
   std::vector<RigidBody> bodies_;
+  std::vector<Capsule<D>> capsules_;
+  // The union of the IB stencils of the current step (collect_forced_nodes) and, for capsules,
+  // the forced velocity at those nodes; buffers only grow.
+  std::vector<std::ptrdiff_t> forced_nodes_;
+  std::vector<std::int32_t> slot_;
+  std::vector<std::uint32_t> stamp_;
+  std::uint32_t stamp_now_ = 0;
+  std::vector<Vec<D>> velocity_;
+  std::vector<CapsuleTrack> capsule_tracks_;
   std::array<bool, D> periodic_{};
   std::vector<io::SeriesColumn> columns_;
   double mass0_ = 1.0;
   long step_ = 0;  // the coarse step in progress (for messages)
-  double seconds_fluid_ = 0, seconds_ib_ = 0, seconds_diagnostics_ = 0, seconds_output_ = 0;
+  double seconds_fluid_ = 0, seconds_ib_ = 0, seconds_membrane_ = 0, seconds_diagnostics_ = 0, seconds_output_ = 0;
 };
 
 }  // namespace caplab::sim

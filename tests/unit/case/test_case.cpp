@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <set>
 #include <string>
 #include <tuple>
@@ -94,7 +95,8 @@ void expect_cylinder_common(const CaseSpec& spec) {
   EXPECT_EQ(p.bodies[0].shape.type, ShapeSpec::Type::circle);
   EXPECT_EQ(p.bodies[0].shape.center, (std::vector<double>{10, 10}));
   EXPECT_DOUBLE_EQ(p.bodies[0].shape.diameter, 1);
-  EXPECT_EQ(p.bodies[0].motion.type, RigidMotionSpec::Type::fixed);
+  ASSERT_TRUE(p.bodies[0].motion.has_value());
+  EXPECT_EQ(p.bodies[0].motion->type, RigidMotionSpec::Type::fixed);
 
   const NumericsSpec& n = spec.numerics;
   EXPECT_EQ(n.grid.refinement, GridSpec::Refinement::two_level);
@@ -406,6 +408,86 @@ TEST(case_rejects, ToleranceForAnUndefinedOrMissingLevel) {
   expect_doc_rejected(doc, "/acceptance/0/tolerance", {"no tolerance for fidelity level \"thesis\""});
 }
 
+// ---------------------------------------------------------------- acceptance entries: mode
+
+/// The cylinder case with a fourth acceptance entry comparing the flow regime (entry 3).
+json with_mode_entry(const json& reference_mode) {
+  json doc = cylinder_json();
+  json entry = {{"metric", "mode"},
+                {"reference", "references/capsule2d/claims.json#ch3.ellipse.G0.04.Eb0.06"},
+                {"comparison", "mode"},
+                {"justification", "thesis section 3.2.2 states the regime"}};
+  if (!reference_mode.is_null()) entry["reference_mode"] = reference_mode;
+  doc["acceptance"].push_back(entry);
+  return doc;
+}
+
+TEST(case_acceptance, ModeEntryWithANameOrAnArrayLoads) {
+  for (const json& modes : {json("tumbling"), json({"steady_tank_treading", "oscillating_tank_treading"})}) {
+    SCOPED_TRACE(modes.dump());
+    const CaseSpec spec = parse_case(with_mode_entry(modes), "edited.json", "standard", {});
+    ASSERT_EQ(spec.acceptance.size(), 4u);
+    const AcceptanceSpec& a = spec.acceptance[3];
+    EXPECT_EQ(a.metric, "mode");
+    EXPECT_EQ(a.comparison, "mode");
+    EXPECT_TRUE(a.tolerance.empty());  // matched exactly: no tolerance per level
+    EXPECT_EQ(a.reference_modes,
+              modes.is_array() ? modes.get<std::vector<std::string>>() : std::vector<std::string>{modes});
+    EXPECT_EQ(spec.resolved["acceptance"][3]["reference_mode"], modes);  // what the scorer reads
+    EXPECT_FALSE(spec.resolved["acceptance"][3].contains("tolerance"));
+  }
+  // An override may change the regime like any other value.
+  const CaseSpec set = parse_case(with_mode_entry("tumbling"), "edited.json", "standard",
+                                  {"acceptance.3.reference_mode=steady_tank_treading"});
+  EXPECT_EQ(set.resolved["acceptance"][3]["reference_mode"], "steady_tank_treading");
+}
+
+TEST(case_rejects, ModeEntryWithoutReferenceMode) {
+  expect_doc_rejected(with_mode_entry(nullptr), "/acceptance/3/reference_mode",
+                      {"required key \"reference_mode\" is missing", "\"tumbling\"", "non-empty array",
+                       "required when /acceptance/3/comparison is \"mode\""});
+}
+
+TEST(case_rejects, ModeEntryWithANumericReferenceOrTolerance) {
+  json doc = with_mode_entry("tumbling");
+  doc["acceptance"][3]["tolerance"] = {{"quick", 0.1}, {"standard", 0.1}, {"thesis", 0.1}};
+  expect_doc_rejected(doc, "/acceptance/3/tolerance",
+                      {"no \"tolerance\" key", "matched exactly", "remove it"});
+  doc = with_mode_entry("tumbling");
+  doc["acceptance"][3]["reference_value"] = 1;
+  expect_doc_rejected(doc, "/acceptance/3/reference_value", {"no \"reference_value\" key"});
+}
+
+TEST(case_rejects, MalformedOrUnknownReferenceMode) {
+  expect_doc_rejected(with_mode_entry("tumbeling"), "/acceptance/3/reference_mode",
+                      {"\"tumbeling\"", "did you mean \"tumbling\"?"});
+  expect_doc_rejected(
+      with_mode_entry({"tumbling", "swinging"}), "/acceptance/3/reference_mode/1",
+      {"\"swinging\"", "\"steady_tank_treading\", \"oscillating_tank_treading\", \"tumbling\""});
+  expect_doc_rejected(with_mode_entry(json::array()), "/acceptance/3/reference_mode", {"non-empty array"});
+  expect_doc_rejected(with_mode_entry(2), "/acceptance/3/reference_mode", {"a mode name"});
+  expect_doc_rejected(with_mode_entry({"tumbling", 2}), "/acceptance/3/reference_mode/1", {"a mode name"});
+  expect_doc_rejected(with_mode_entry(""), "/acceptance/3/reference_mode",
+                      {"one of \"steady_tank_treading\""});
+}
+
+TEST(case_rejects, NumericEntryNeedsValueAndToleranceAndNoReferenceMode) {
+  json doc = cylinder_json();
+  doc["acceptance"][0].erase("reference_value");
+  expect_doc_rejected(doc, "/acceptance/0/reference_value",
+                      {"required key \"reference_value\" is missing", "a finite number",
+                       "required when /acceptance/0/comparison is \"relative\""});
+  doc = cylinder_json();
+  doc["acceptance"][0].erase("tolerance");
+  expect_doc_rejected(doc, "/acceptance/0/tolerance", {"required key \"tolerance\" is missing"});
+  doc = cylinder_json();
+  doc["acceptance"][0]["reference_mode"] = "tumbling";
+  expect_doc_rejected(doc, "/acceptance/0/reference_mode",
+                      {"no \"reference_mode\" key", "belongs to the comparison \"mode\""});
+  expect_set_rejected({"acceptance.0.comparison=modes"}, "/acceptance/0/comparison",
+                      {"\"relative\", \"absolute\", \"mode\"", "did you mean \"mode\"?"});
+}
+
 TEST(case_rejects, DuplicateBodyNames) {
   json doc = cylinder_json();
   json second = doc["physics"]["bodies"][0];
@@ -525,6 +607,18 @@ TEST(case_schema, ComparisonDetectsADifference) {
   EXPECT_NE(published_keys(schema, schema, ""), loader_keys());
 }
 
+TEST(case_schema, PublishedModesAreTheOnesTheLoaderAccepts) {
+  const json schema = schema_json();
+  const json& mode = schema["properties"]["acceptance"]["items"]["properties"]["reference_mode"];
+  const std::vector<std::string> names = mode["anyOf"][0]["enum"].get<std::vector<std::string>>();
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"steady_tank_treading", "oscillating_tank_treading", "tumbling"}));
+  EXPECT_EQ(mode["anyOf"][1]["items"]["enum"], mode["anyOf"][0]["enum"]);
+  for (const auto& name : names)
+    EXPECT_NO_THROW(parse_case(with_mode_entry(name), "edited.json", "standard", {}));
+  EXPECT_NO_THROW(parse_case(with_mode_entry(names), "edited.json", "standard", {}));
+}
+
 TEST(case_schema, DefaultsMatchTheSpecDefaults) {
   const json schema = schema_json();
   const json& numerics = schema["properties"]["numerics"]["properties"];
@@ -538,6 +632,93 @@ TEST(case_schema, DefaultsMatchTheSpecDefaults) {
   EXPECT_EQ(numerics["threads"]["default"], defaults.numerics.threads);
   EXPECT_EQ(schema["properties"]["outputs"]["properties"]["average_from"]["default"],
             defaults.outputs.average_from);
+}
+
+// ---------------------------------------------------------------- capsules
+const fs::path capsule_file = source_dir / "catalogue/ch3/ellipse_initial_G0.04_Eb0.4.json";
+json capsule_json() { return read_case_json(capsule_file); }
+
+TEST(case_capsule, LoadsTheMembraneAndShapeWithDefaultsWritten) {
+  const CaseSpec spec = load_case(capsule_file, "standard");
+  ASSERT_EQ(spec.physics.bodies.size(), 1u);
+  const BodySpec& b = spec.physics.bodies[0];
+  ASSERT_TRUE(b.is_capsule());
+  EXPECT_FALSE(b.motion.has_value());
+  EXPECT_EQ(b.shape.type, ShapeSpec::Type::ellipse);
+  EXPECT_DOUBLE_EQ(b.shape.aspect_ratio, 2.0);
+  EXPECT_DOUBLE_EQ(b.membrane->capillary, 0.04);
+  EXPECT_DOUBLE_EQ(b.membrane->bending_ratio, 0.4);
+  EXPECT_EQ(b.membrane->reference_curvature, MembraneSpec::ReferenceCurvature::initial);
+  EXPECT_EQ(b.membrane->nodes, 160);
+  // The quick level halves the membrane nodes with the grid spacing.
+  EXPECT_EQ(load_case(capsule_file, "quick").physics.bodies[0].membrane->nodes, 80);
+  // Defaults are written back into the resolved case.
+  json doc = capsule_json();
+  doc["physics"]["bodies"][0]["membrane"].erase("reference_curvature");
+  doc["physics"]["bodies"][0]["membrane"].erase("bending_ratio");
+  const CaseSpec d = parse_case(doc, "edited.json", "standard", {});
+  EXPECT_EQ(d.resolved["physics"]["bodies"][0]["membrane"]["reference_curvature"], "initial");
+  EXPECT_EQ(d.resolved["physics"]["bodies"][0]["membrane"]["bending_ratio"], 0.0);
+  EXPECT_EQ(d.resolved["physics"]["bodies"][0]["shape"]["angle"], 0.0);
+}
+
+TEST(case_capsule, RejectsABodyWithBothOrNeitherMotionAndMembrane) {
+  json both = capsule_json();
+  both["physics"]["bodies"][0]["motion"] = {{"type", "fixed"}};
+  expect_doc_rejected(both, "/physics/bodies/0", {"both", "exactly one", "capsule"});
+  json neither = capsule_json();
+  neither["physics"]["bodies"][0].erase("membrane");
+  expect_doc_rejected(neither, "/physics/bodies/0", {"neither", "rigid body"});
+}
+
+TEST(case_capsule, RejectsBadMembraneValues) {
+  json doc = capsule_json();
+  doc["physics"]["bodies"][0]["membrane"]["capillary"] = -0.04;
+  expect_doc_rejected(doc, "/physics/bodies/0/membrane/capillary", {"> 0"});
+  doc = capsule_json();
+  doc["physics"]["bodies"][0]["membrane"]["law"] = "skalak";
+  expect_doc_rejected(doc, "/physics/bodies/0/membrane/law", {"hooke"});
+  doc = capsule_json();
+  doc["physics"]["bodies"][0]["membrane"]["reference_curvature"] = "sphere";
+  expect_doc_rejected(doc, "/physics/bodies/0/membrane/reference_curvature", {"initial", "circle", "flat"});
+  doc = capsule_json();
+  doc["physics"]["bodies"][0]["membrane"]["stiffness"] = 1;
+  expect_doc_rejected(doc, "/physics/bodies/0/membrane/stiffness", {"unknown key", "capillary"});
+}
+
+TEST(case_capsule, RejectsAMembraneTooCoarseForTheGrid) {
+  // 20 nodes on a 2:1 ellipse of equivalent radius 1: ~0.38 L apart, 7.7 fine spacings.
+  expect_rejected([] { load_case(capsule_file, "standard", {"physics.bodies.0.membrane.nodes=20"}); },
+                  "/physics/bodies/0/membrane/nodes", {"at least", "fine spacings", "leaks"});
+}
+
+TEST(case_capsule, RejectsACapsuleReachingOutOfTheFineBlock) {
+  // The 2:1 ellipse reaches sqrt(2) = 1.41 from its centre: at x = 6.4 it crosses the margin
+  // of the fine block [5, 11] although a circle of the same equivalent radius would fit.
+  expect_rejected([] { load_case(capsule_file, "standard", {"physics.bodies.0.shape.center=[6.4, 8]"}); },
+                  "/physics/bodies/0/shape/center", {"fine region", "reaching 1.414"});
+}
+
+TEST(case_capsule, RejectsUnsupportedCombinations) {
+  json rigid_ellipse = cylinder_json();
+  rigid_ellipse["physics"]["bodies"][0]["shape"]["type"] = "ellipse";
+  expect_doc_rejected(rigid_ellipse, "/physics/bodies/0/shape/type", {"circle", "rigid body"});
+  json sphere_capsule = capsule_json();
+  sphere_capsule["physics"]["bodies"][0]["shape"]["type"] = "sphere";
+  expect_doc_rejected(sphere_capsule, "/physics/bodies/0/shape/type", {"2D shape", "ellipse"});
+  // A capsule quantity in a scene without capsules is an input error of the scene builder
+  // (sim), not of the loader; a membrane in 3D is refused here.
+  json three_d = capsule_json();
+  three_d["physics"]["dimension"] = 3;
+  three_d["physics"]["domain"]["size"] = {16, 16, 16};
+  three_d["physics"]["domain"]["boundaries"] = {"far_field", "far_field", "far_field"};
+  three_d["physics"]["bodies"][0]["shape"]["type"] = "sphere";
+  three_d["physics"]["bodies"][0]["shape"]["center"] = {8, 8, 8};
+  three_d["physics"]["bodies"][0]["shape"].erase("aspect_ratio");
+  three_d["numerics"]["grid"]["fine_region"] = {{"min", {5, 5, 5}}, {"max", {11, 11, 11}}};
+  three_d["fidelity"] = {{"standard", json::object()}};
+  three_d.erase("acceptance");
+  expect_doc_rejected(three_d, "/physics/bodies/0/membrane", {"3D membranes", "not implemented"});
 }
 
 }  // namespace

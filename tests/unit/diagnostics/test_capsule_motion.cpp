@@ -42,8 +42,8 @@ TEST(AngleUnwrapper, FollowsAnAxisThroughManyTurns) {
   AngleUnwrapper unwrap(pi);
   double last = 0;
   for (int i = 0; i <= 1000; ++i) {
-    const double truth = -0.05 * i;                                  // 50 rad clockwise
-    const double axis = truth - pi * std::floor(truth / pi + 0.5);   // folded into [-pi/2, pi/2)
+    const double truth = -0.05 * i;                                 // 50 rad clockwise
+    const double axis = truth - pi * std::floor(truth / pi + 0.5);  // folded into [-pi/2, pi/2)
     last = unwrap(axis);
     ASSERT_NEAR(last, truth, 1e-12) << "sample " << i;
   }
@@ -52,8 +52,9 @@ TEST(AngleUnwrapper, FollowsAnAxisThroughManyTurns) {
 }
 
 TEST(CapsuleMotion, SteadyTankTreading) {
-  const auto s = sample(10, 0.01, [](double t) { return pi / 4 - 0.2 * (1 - std::exp(-t)); },
-                        [](double t) { return -0.4 * t; });
+  const auto s = sample(
+      10, 0.01, [](double t) { return pi / 4 - 0.2 * (1 - std::exp(-t)); },
+      [](double t) { return -0.4 * t; });
   const auto m = classify_capsule_motion(s.t, s.theta, s.phi, 6);
   EXPECT_EQ(m.mode, "steady_tank_treading");
   EXPECT_NEAR(m.tank_treading_rate, 0.4, 1e-12);
@@ -62,12 +63,14 @@ TEST(CapsuleMotion, SteadyTankTreading) {
 
 TEST(CapsuleMotion, OscillatingTankTreading) {
   const double amp = 3 * pi / 180;  // 3 degrees, above the 1 degree threshold
-  const auto s = sample(20, 0.01, [&](double t) { return 0.3 + amp * std::sin(2 * t); }, [](double t) { return -0.5 * t; });
+  const auto s = sample(
+      20, 0.01, [&](double t) { return 0.3 + amp * std::sin(2 * t); }, [](double t) { return -0.5 * t; });
   const auto m = classify_capsule_motion(s.t, s.theta, s.phi, 5);
   EXPECT_EQ(m.mode, "oscillating_tank_treading");
   EXPECT_NEAR(m.inclination_amplitude, amp, 1e-4);
   // The same signal with a 0.5 degree wobble is steady.
-  const auto small = sample(20, 0.01, [&](double t) { return 0.3 + amp / 6 * std::sin(2 * t); }, [](double t) { return -0.5 * t; });
+  const auto small = sample(
+      20, 0.01, [&](double t) { return 0.3 + amp / 6 * std::sin(2 * t); }, [](double t) { return -0.5 * t; });
   EXPECT_EQ(classify_capsule_motion(small.t, small.theta, small.phi, 5).mode, "steady_tank_treading");
 }
 
@@ -75,7 +78,9 @@ TEST(CapsuleMotion, JefferyOrbitTumblesWithItsPeriod) {
   const double r = 2;
   const double half_period = pi * (1 + r * r) / r;  // 7.854 for r = 2
   // Window over exactly two half-turns, so the mean rate is exact.
-  const auto s = sample(3 * half_period, 1e-3, [&](double t) { return jeffery(t, r); }, [&](double t) { return jeffery(t, r); });
+  const auto s = sample(
+      3 * half_period, 1e-3, [&](double t) { return jeffery(t, r); },
+      [&](double t) { return jeffery(t, r); });
   const auto m = classify_capsule_motion(s.t, s.theta, s.phi, half_period);
   EXPECT_EQ(m.mode, "tumbling");
   ASSERT_TRUE(m.tumbling_period.has_value());

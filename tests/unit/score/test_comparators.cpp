@@ -1,4 +1,4 @@
-// Unit tests of the score comparators (relative, absolute, bracket, time_series) and of the
+// Unit tests of the score comparators (relative, absolute, bracket, time_series, mode) and of the
 // reference CSV reader. Every comparator is shown to accept what it should and to reject what
 // it must (DESIGN.md section 7: every check must be able to fail).
 #include <gtest/gtest.h>
@@ -181,6 +181,33 @@ TEST(ScoreTimeSeries, RejectsMalformedSeries) {
   EXPECT_THROW(rms_distance(Series{{0.0, 0.5, 0.5, 1.0}, {0, 0, 0, 0}}, good), core::Error);
   EXPECT_THROW(rms_distance(good, Series{{0.0, 0.5, 1.0}, {0.0, kNaN, 0.0}}), core::Error);
   EXPECT_FALSE(compare_time_series(good, good, -1.0).pass);
+}
+
+TEST(ScoreMode, PassesOnOneOfTheReferenceModes) {
+  const Comparison c = compare_mode("tumbling", {"tumbling"});
+  EXPECT_TRUE(c.pass);
+  EXPECT_EQ(c.error, 0.0);
+  EXPECT_TRUE(c.message.empty());
+  EXPECT_TRUE(
+      compare_mode("oscillating_tank_treading", {"steady_tank_treading", "oscillating_tank_treading"}).pass);
+}
+
+TEST(ScoreMode, MustFail) {
+  const Comparison wrong = compare_mode("steady_tank_treading", {"tumbling"});
+  EXPECT_FALSE(wrong.pass);
+  EXPECT_EQ(wrong.error, 1.0);
+  EXPECT_EQ(wrong.message, "mode \"steady_tank_treading\" is not the reference \"tumbling\"");
+  const Comparison neither = compare_mode("tumbling", {"steady_tank_treading", "oscillating_tank_treading"});
+  EXPECT_FALSE(neither.pass);
+  EXPECT_NE(neither.message.find("\"steady_tank_treading\" or \"oscillating_tank_treading\""),
+            std::string::npos);
+  EXPECT_FALSE(compare_mode("Tumbling", {"tumbling"}).pass);  // exact, case-sensitive
+  EXPECT_FALSE(compare_mode("tumbling", {}).pass);
+  EXPECT_FALSE(compare_mode("", {""}).pass);
+  EXPECT_FALSE(compare_mode("", {"tumbling"}).pass);
+  EXPECT_FALSE(compare_mode("tumbling", {"tumbling", ""}).pass);
+  EXPECT_TRUE(std::isnan(compare_mode("tumbling", {}).error));
+  EXPECT_FALSE(compare_mode("tumbling", {}).message.empty());
 }
 
 class ScoreReferenceCsv : public ::testing::Test {

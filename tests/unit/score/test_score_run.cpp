@@ -1,7 +1,8 @@
 // Unit tests of run-directory scoring: hand-written run directories (manifest.json, case.json,
 // summary.json, series.h5) scored end to end — a passing case, a failing one (strict exit 1),
 // a diverged and an unfinished run, a missing and a NaN metric, a tolerance missing for the
-// fidelity, mass drift, bracket and time-series entries, and the scorecard text.
+// fidelity, mass drift, bracket, time-series and mode entries, string-valued metrics, and the
+// scorecard text.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -39,6 +40,9 @@ json cylinder_case() {
   doc["acceptance"] = json::array({doc["acceptance"][0]});
   return doc;
 }
+
+/// "/acceptance/<i>/reference_mode": where a malformed mode entry's message must point.
+std::string fmt_index(std::size_t i) { return "/acceptance/" + std::to_string(i) + "/reference_mode"; }
 
 json metric(double v, const std::string& unit = "1") {
   return {{"value", v}, {"unit", unit}, {"definition", "test"}};
@@ -307,6 +311,141 @@ TEST_F(ScoreRun, TimeSeriesWithoutSeriesFileFails) {
   const json s = score();
   EXPECT_NE(s["accuracy"]["entries"][0]["message"].get<std::string>().find("series.h5 is missing"),
             std::string::npos);
+}
+
+/// A mode acceptance entry (capsule flow regime against a thesis statement).
+json mode_entry(const json& reference_mode) {
+  json entry = {{"metric", "mode"},
+                {"reference", "references/capsule2d/claims.json#ch3.ellipse.G0.04.Eb0.06"},
+                {"comparison", "mode"},
+                {"justification", "thesis section 3.2.2: tumbling at E_b = 0.06"}};
+  if (!reference_mode.is_null()) entry["reference_mode"] = reference_mode;
+  return entry;
+}
+
+json mode_metric(const json& value) {
+  return {{"value", value}, {"unit", "1"}, {"definition", "flow regime over t >= average_from"}};
+}
+
+TEST_F(ScoreRun, ModeEntryPassesOnTheStatedRegime) {
+  summary_["metrics"]["mode"] = mode_metric("tumbling");
+  summary_["metrics"]["tumbling_period"] = metric(7.9, "1/k");
+  const json alternatives = {"steady_tank_treading", "tumbling"};
+  // The same metric twice is fine for the scorer (the loader rejects it in a catalogue case).
+  case_["acceptance"] = json::array({mode_entry("tumbling"), mode_entry(alternatives)});
+  const json s = score();
+  EXPECT_EQ(s["sanity"]["verdict"], "pass");  // a string metric is sane
+  EXPECT_EQ(check(s, "metrics_finite")["value"], 0);
+  EXPECT_EQ(s["accuracy"]["verdict"], "pass") << s.dump(2);
+  const json& e = s["accuracy"]["entries"][0];
+  EXPECT_EQ(e["value"], "tumbling");
+  EXPECT_EQ(e["reference_value"], "tumbling");
+  EXPECT_EQ(e["comparison"], "mode");
+  EXPECT_EQ(e["error"], 0.0);
+  EXPECT_TRUE(e["tolerance"].is_null());
+  EXPECT_EQ(e["reference"], "references/capsule2d/claims.json#ch3.ellipse.G0.04.Eb0.06");
+  EXPECT_EQ(e["verdict"], "pass");
+  EXPECT_FALSE(e.contains("message"));
+  EXPECT_EQ(s["accuracy"]["entries"][1]["reference_value"], alternatives);  // as written
+  EXPECT_EQ(s["accuracy"]["entries"][1]["verdict"], "pass");
+  EXPECT_EQ(exit_code(s, true), 0);
+}
+
+TEST_F(ScoreRun, ModeEntryMustFail) {
+  // the wrong regime
+  summary_["metrics"]["mode"] = mode_metric("steady_tank_treading");
+  case_["acceptance"] =
+      json::array({mode_entry("tumbling"), mode_entry({"tumbling", "oscillating_tank_treading"})});
+  json s = score();
+  EXPECT_EQ(s["sanity"]["verdict"], "pass");
+  EXPECT_EQ(s["accuracy"]["verdict"], "fail");
+  const json& wrong = s["accuracy"]["entries"][0];
+  EXPECT_EQ(wrong["verdict"], "fail");
+  EXPECT_EQ(wrong["error"], 1.0);
+  EXPECT_EQ(wrong["value"], "steady_tank_treading");
+  EXPECT_EQ(wrong["message"], "mode \"steady_tank_treading\" is not the reference \"tumbling\"");
+  EXPECT_EQ(s["accuracy"]["entries"][1]["verdict"], "fail");
+  EXPECT_EQ(exit_code(s, true), 1);
+
+  // the mode metric missing
+  summary_["metrics"].erase("mode");
+  case_["acceptance"] = json::array({mode_entry("tumbling")});
+  s = score();
+  EXPECT_EQ(s["accuracy"]["entries"][0]["verdict"], "fail");
+  EXPECT_EQ(s["accuracy"]["entries"][0]["message"],
+            "metric mode not in summary.json (available: drag_coefficient_mean, lift_coefficient_rms, "
+            "strouhal_number)");
+
+  // a number where a mode is expected
+  summary_["metrics"]["mode"] = metric(2.0);
+  s = score();
+  EXPECT_EQ(s["accuracy"]["entries"][0]["verdict"], "fail");
+  EXPECT_EQ(s["accuracy"]["entries"][0]["value"], 2.0);
+  EXPECT_NE(s["accuracy"]["entries"][0]["message"].get<std::string>().find(
+                "metric mode is the number 2.0: a mode comparison needs a string"),
+            std::string::npos)
+      << s["accuracy"]["entries"][0]["message"];
+  EXPECT_EQ(s["sanity"]["verdict"], "pass");  // a finite number is sane; it is the entry that fails
+}
+
+TEST_F(ScoreRun, MalformedReferenceModeFails) {
+  summary_["metrics"]["mode"] = mode_metric("tumbling");
+  const std::vector<json> malformed = {
+      nullptr, 3, json::array(), json::array({"tumbling", 3}), "", json::object({{"mode", "tumbling"}})};
+  case_["acceptance"] = json::array();
+  for (const auto& m : malformed) case_["acceptance"].push_back(mode_entry(m));
+  const json s = score();
+  EXPECT_EQ(s["accuracy"]["verdict"], "fail");
+  const auto& entries = s["accuracy"]["entries"];
+  ASSERT_EQ(entries.size(), malformed.size());
+  EXPECT_EQ(
+      entries[0]["message"],
+      "/acceptance/0/reference_mode is missing: expected a mode name such as \"tumbling\" or a non-empty "
+      "array of mode names");
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(entries[i]["verdict"], "fail");
+    EXPECT_NE(entries[i]["message"].get<std::string>().find(fmt_index(i)), std::string::npos)
+        << entries[i]["message"];
+  }
+  EXPECT_NE(entries[1]["message"].get<std::string>().find("reference_mode is 3: expected"),
+            std::string::npos);
+}
+
+TEST_F(ScoreRun, StringMetricsAreSaneButNotNumbers) {
+  summary_["metrics"]["mode"] = mode_metric("oscillating_tank_treading");
+  summary_["metrics"]["regime_note"] = "tumbling";  // a bare string is a metric too
+  json s = score();
+  EXPECT_EQ(check(s, "metrics_finite")["verdict"], "pass");
+  EXPECT_EQ(s["sanity"]["verdict"], "pass");
+  // an empty string, a boolean and a NaN number are not
+  summary_["metrics"]["mode"] = mode_metric("");
+  summary_["metrics"]["flag"] = metric(0);
+  summary_["metrics"]["flag"]["value"] = true;
+  summary_["metrics"]["strouhal_number"] = metric(std::nan(""));
+  s = score();
+  EXPECT_EQ(check(s, "metrics_finite")["value"], 3);
+  for (const char* name : {"mode", "flag", "strouhal_number"})
+    EXPECT_NE(check(s, "metrics_finite")["message"].get<std::string>().find(name), std::string::npos) << name;
+  EXPECT_EQ(s["sanity"]["verdict"], "fail");
+  // a numeric comparison of a string metric says to use "mode"
+  summary_["metrics"]["drag_coefficient_mean"] = mode_metric("tumbling");
+  s = score();
+  const json& e = s["accuracy"]["entries"][0];
+  EXPECT_EQ(e["verdict"], "fail");
+  EXPECT_EQ(e["value"], "tumbling");
+  EXPECT_NE(e["message"].get<std::string>().find("a relative comparison needs a number"), std::string::npos)
+      << e["message"];
+  EXPECT_NE(e["message"].get<std::string>().find("\"mode\""), std::string::npos);
+}
+
+TEST_F(ScoreRun, ScorecardShowsModesAsText) {
+  summary_["metrics"]["mode"] = mode_metric("steady_tank_treading");
+  case_["acceptance"] = json::array({mode_entry({"tumbling", "oscillating_tank_treading"})});
+  const std::string card = format_scorecard(score());
+  for (const char* part : {"mode", "steady_tank_treading", "tumbling or oscillating_tank_treading", "fail",
+                           "is not the reference"})
+    EXPECT_NE(card.find(part), std::string::npos) << part << " missing in\n" << card;
 }
 
 TEST_F(ScoreRun, CaseWithoutAcceptanceIsNotJudged) {
