@@ -68,11 +68,6 @@ Eigen::Matrix2d central_second_moment(std::span<const Vec<2>> X, double& area, V
 
 }  // namespace
 
-double polygon_area(std::span<const Vec<2>> X) {
-  if (X.size() < 3) return 0.0;
-  return moments_about(X, vertex_mean(X)).area;
-}
-
 double polygon_perimeter(std::span<const Vec<2>> X) {
   double p = 0.0;
   const std::size_t n = X.size();

@@ -36,9 +36,6 @@ struct EquivalentEllipse {
   Vec<2> centroid = Vec<2>::Zero();
 };
 
-/// Signed area of the closed polygon X (positive when counter-clockwise); 0 for < 3 nodes.
-double polygon_area(std::span<const Vec<2>> X);
-
 /// Perimeter of the closed polygon X (including the edge from the last node to the first).
 double polygon_perimeter(std::span<const Vec<2>> X);
 

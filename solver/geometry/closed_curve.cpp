@@ -109,18 +109,6 @@ std::vector<Vec<2>> equal_arc_points(const Curve& curve, int n) {
   return X;
 }
 
-// Signed area of the closed polygon (positive for counter-clockwise).
-double shoelace(const std::vector<Vec<2>>& X) {
-  double twice = 0.0;
-  const std::size_t n = X.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec<2>& a = X[i];
-    const Vec<2>& b = X[(i + 1) % n];
-    twice += a[0] * b[1] - a[1] * b[0];
-  }
-  return 0.5 * twice;
-}
-
 void check_positive(const char* what, double value) {
   std::ostringstream msg;
   msg << "ring nodes: " << what << " is " << value << ", expected positive and finite";
@@ -128,6 +116,20 @@ void check_positive(const char* what, double value) {
 }
 
 }  // namespace
+
+double polygon_area(std::span<const Vec<2>> X) {
+  const std::size_t n = X.size();
+  if (n < 3) return 0.0;
+  Vec<2> c = Vec<2>::Zero();  // shoelace about the vertex mean: less round-off far from the origin
+  for (const auto& x : X) c += x;
+  c /= static_cast<double>(n);
+  double twice = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec<2> a = X[i] - c, b = X[(i + 1) % n] - c;
+    twice += a[0] * b[1] - a[1] * b[0];
+  }
+  return 0.5 * twice;
+}
 
 std::vector<Vec<2>> ring_nodes(const RingShape& shape, const Vec<2>& center, double equivalent_radius,
                                double angle, int nodes) {
@@ -150,7 +152,7 @@ std::vector<Vec<2>> ring_nodes(const RingShape& shape, const Vec<2>& center, dou
       X = equal_arc_points(Biconcave{shape.alpha}, nodes);
       break;
   }
-  const double scale = std::sqrt(std::numbers::pi * equivalent_radius * equivalent_radius / shoelace(X));
+  const double scale = std::sqrt(std::numbers::pi * equivalent_radius * equivalent_radius / polygon_area(X));
   const double c = std::cos(angle), s = std::sin(angle);
   for (Vec<2>& x : X) {
     const Vec<2> body = scale * x;

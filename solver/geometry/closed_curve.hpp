@@ -25,6 +25,7 @@
 // length to ~1e-13 relative, the polygon area is pi a_eq^2 to round-off.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "core/vec.hpp"
@@ -50,5 +51,8 @@ std::vector<Vec<2>> ring_nodes(const RingShape& shape, const Vec<2>& center, dou
 /// For alpha = 1.39 it is 0.740346 (the thesis quotes 0.74). Throws core::Error when
 /// alpha is not positive and finite.
 double biconcave_equivalent_radius(double alpha = 1.39);
+
+/// Signed area enclosed by the closed polygon X (positive when counter-clockwise; 0 for < 3 nodes).
+double polygon_area(std::span<const Vec<2>> X);
 
 }  // namespace caplab::geometry

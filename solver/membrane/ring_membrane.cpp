@@ -6,20 +6,10 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "geometry/closed_curve.hpp"
 
 namespace caplab::membrane {
 namespace {
-
-double shoelace(std::span<const Vec<2>> X) {
-  double twice = 0.0;
-  const std::size_t n = X.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec<2>& a = X[i];
-    const Vec<2>& b = X[(i + 1) % n];
-    twice += a[0] * b[1] - a[1] * b[0];
-  }
-  return 0.5 * twice;
-}
 
 void check_modulus(const char* what, double value) {
   std::ostringstream msg;
@@ -38,7 +28,7 @@ RingMembrane::RingMembrane(std::span<const Vec<2>> rest, double hooke_modulus, d
     CAPLAB_CHECK(std::isfinite(x[0]) && std::isfinite(x[1]), "ring membrane: rest positions must be finite");
   check_modulus("Hooke modulus E", E_);
   check_modulus("bending modulus E_B", E_B_);
-  const double area = shoelace(rest);
+  const double area = geometry::polygon_area(rest);
   CAPLAB_CHECK(area > 0.0, "ring membrane: the rest nodes enclose a signed area " + std::to_string(area) +
                                "; expected counter-clockwise nodes (positive area)");
 

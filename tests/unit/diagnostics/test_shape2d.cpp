@@ -30,7 +30,7 @@ std::vector<Vec<2>> ellipse(const Vec<2>& c, double a, double b, double angle, i
 
 TEST(Shape2d, SquareAndRectangleAreExact) {
   const std::vector<Vec<2>> square = {{1, 1}, {3, 1}, {3, 3}, {1, 3}};
-  EXPECT_DOUBLE_EQ(polygon_area(square), 4.0);
+  EXPECT_DOUBLE_EQ(geometry::polygon_area(square), 4.0);
   EXPECT_DOUBLE_EQ(polygon_perimeter(square), 8.0);
   const auto e = equivalent_ellipse(square);
   EXPECT_DOUBLE_EQ(e.area, 4.0);
@@ -59,7 +59,7 @@ TEST(Shape2d, MomentsAboutTheCentroidNotTheVertexMean) {
   // vertex mean away from the centroid without changing the polygon.
   const double b = 3.0, h = 2.0;
   const std::vector<Vec<2>> tri = {{0, 0}, {0.5, 0}, {1, 0}, {1.5, 0}, {2, 0}, {b, 0}, {0, h}};
-  EXPECT_NEAR(polygon_area(tri), 0.5 * b * h, 1e-15);
+  EXPECT_NEAR(geometry::polygon_area(tri), 0.5 * b * h, 1e-15);
   EXPECT_NEAR((polygon_centroid(tri) - Vec<2>(b / 3, h / 3)).norm(), 0.0, 1e-15);
   const auto J = area_second_moment(tri);
   EXPECT_NEAR(J(0, 0), b * b * b * h / 36, 1e-14);
@@ -117,13 +117,13 @@ TEST(Shape2d, InclinationOfRotatedEllipses) {
 
 TEST(Shape2d, RejectsClockwiseAndDegeneratePolygons) {
   std::vector<Vec<2>> cw = {{0, 0}, {0, 1}, {1, 1}, {1, 0}};
-  EXPECT_LT(polygon_area(cw), 0.0);
+  EXPECT_LT(geometry::polygon_area(cw), 0.0);
   EXPECT_THROW(equivalent_ellipse(cw), core::Error);
   EXPECT_THROW(polygon_centroid(cw), core::Error);
   const std::vector<Vec<2>> line = {{0, 0}, {1, 0}, {2, 0}};
   EXPECT_THROW(equivalent_ellipse(line), core::Error);
   const std::vector<Vec<2>> two = {{0, 0}, {1, 0}};
-  EXPECT_DOUBLE_EQ(polygon_area(two), 0.0);
+  EXPECT_DOUBLE_EQ(geometry::polygon_area(two), 0.0);
   EXPECT_THROW(area_second_moment(two), core::Error);
 }
 
