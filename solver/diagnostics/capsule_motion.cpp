@@ -16,6 +16,29 @@ double AngleUnwrapper::operator()(double angle) {
   return last_ += d - period_ * std::round(d / period_);
 }
 
+namespace {
+
+// Turns of v by more than `swing` back from its extreme since the last turn (a zigzag
+// filter): 0 for a monotone signal, however it curves.
+int reversals(std::span<const double> v, double swing) {
+  int dir = 0, turns = 0;
+  double hi = v.front(), lo = v.front();
+  for (const double x : v) {
+    hi = std::max(hi, x);
+    lo = std::min(lo, x);
+    if (dir >= 0 && hi - x > swing) {  // fell from a maximum
+      if (dir > 0) ++turns;
+      dir = -1, hi = lo = x;
+    } else if (dir <= 0 && x - lo > swing) {  // rose from a minimum
+      if (dir < 0) ++turns;
+      dir = 1, hi = lo = x;
+    }
+  }
+  return turns;
+}
+
+}  // namespace
+
 CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const double> inclination,
                                       std::span<const double> phase, double t_from,
                                       double oscillation_threshold) {
@@ -30,6 +53,7 @@ CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const
   m.inclination_turn = *hi_all - *lo_all;
   const auto [lo, hi] = std::minmax_element(inclination.begin() + first, inclination.end());
   m.inclination_amplitude = 0.5 * (*hi - *lo);
+  m.inclination_reversals = reversals(inclination.subspan(first), 2 * oscillation_threshold);
   const double span = t[last] - t[first];
   m.tank_treading_rate = std::abs(phase[last] - phase[first]) / span;
   if (m.inclination_turn > std::numbers::pi) {
@@ -37,8 +61,7 @@ CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const
     const double turn = std::abs(inclination[last] - inclination[first]);
     if (turn > 0) m.tumbling_period = std::numbers::pi * span / turn;
   } else {
-    m.mode = m.inclination_amplitude > oscillation_threshold ? "oscillating_tank_treading"
-                                                             : "steady_tank_treading";
+    m.mode = m.inclination_reversals > 0 ? "oscillating_tank_treading" : "steady_tank_treading";
   }
   return m;
 }

@@ -8,8 +8,10 @@
 // Classification (times in 1/k):
 //   tumbling                   the inclination turns through more than pi over the run (the
 //                              thesis: "the oscillation amplitude is larger than pi", ch. 3.2.2);
-//   oscillating_tank_treading  otherwise, when (max - min)/2 of theta over t >= t_from exceeds
-//                              `oscillation_threshold` (default 1 degree);
+//   oscillating_tank_treading  otherwise, when theta reverses its direction in t >= t_from by
+//                              more than twice `oscillation_threshold` (default 1 degree, so a
+//                              swing of 2 degrees peak to peak): a monotone approach to the
+//                              steady inclination, however fast, is not an oscillation;
 //   steady_tank_treading       otherwise.
 // Rates over the window t >= t_from: tank-treading angular rate |phi(end) - phi(from)| / (end - from)
 // (so T = 2 pi / rate, thesis ch. 3 f = 4 pi/(k T) = 2 rate/k, ch. 4 f/k = rate/k), and for a
@@ -45,6 +47,7 @@ struct CapsuleMotion {
   std::string mode;                       ///< steady_tank_treading | oscillating_tank_treading | tumbling
   double inclination_turn = 0;            ///< max - min of theta over the whole run (rad)
   double inclination_amplitude = 0;       ///< (max - min)/2 of theta over the window (rad)
+  int inclination_reversals = 0;          ///< turns of theta by more than 2 x threshold in the window
   double tank_treading_rate = 0;          ///< |d phi/dt| averaged over the window (rad per 1/k)
   std::optional<double> tumbling_period;  ///< time of a half-turn of theta (1/k), when tumbling
 };

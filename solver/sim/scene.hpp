@@ -685,9 +685,11 @@ class Scene {
         {"value", motion.mode},
         {"unit", ""},
         {"definition", fmt::format("tumbling when the inclination turns through more than pi over the run (it "
-                                   "turned {:.3f} rad); else oscillating_tank_treading when its (max - min)/2{} "
-                                   "exceeds 1 degree (it is {:.4f} rad), else steady_tank_treading",
-                                   motion.inclination_turn, window, motion.inclination_amplitude)}};
+                                   "turned {:.3f} rad); else oscillating_tank_treading when it reverses{} by more "
+                                   "than 2 degrees (it reversed {} times; (max - min)/2 = {:.4f} rad), else "
+                                   "steady_tank_treading",
+                                   motion.inclination_turn, window, motion.inclination_reversals,
+                                   motion.inclination_amplitude)}};
     if (motion.mode == "tumbling") {
       if (motion.tumbling_period)
         metrics[prefix + "tumbling_period"] = {

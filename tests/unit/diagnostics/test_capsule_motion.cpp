@@ -61,6 +61,17 @@ TEST(CapsuleMotion, SteadyTankTreading) {
   EXPECT_FALSE(m.tumbling_period.has_value());
 }
 
+TEST(CapsuleMotion, FastMonotoneApproachIsSteady) {
+  // 10 degrees of drift inside the window, but no reversal: still the transient of a steady
+  // tank-treader (e.g. a short grid-study run), not an oscillation.
+  const auto s = sample(
+      4, 0.01, [](double t) { return 0.4 + 0.35 * std::exp(-t); }, [](double t) { return -0.3 * t; });
+  const auto m = classify_capsule_motion(s.t, s.theta, s.phi, 1.0);
+  EXPECT_GT(m.inclination_amplitude, 3 * pi / 180);
+  EXPECT_EQ(m.inclination_reversals, 0);
+  EXPECT_EQ(m.mode, "steady_tank_treading");
+}
+
 TEST(CapsuleMotion, OscillatingTankTreading) {
   const double amp = 3 * pi / 180;  // 3 degrees, above the 1 degree threshold
   const auto s = sample(
@@ -68,6 +79,7 @@ TEST(CapsuleMotion, OscillatingTankTreading) {
   const auto m = classify_capsule_motion(s.t, s.theta, s.phi, 5);
   EXPECT_EQ(m.mode, "oscillating_tank_treading");
   EXPECT_NEAR(m.inclination_amplitude, amp, 1e-4);
+  EXPECT_GE(m.inclination_reversals, 8);  // sin(2t) over t in [5, 20]: 9 extremes, 8 turns between them
   // The same signal with a 0.5 degree wobble is steady.
   const auto small = sample(
       20, 0.01, [&](double t) { return 0.3 + amp / 6 * std::sin(2 * t); }, [](double t) { return -0.5 * t; });
