@@ -58,8 +58,20 @@ CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const
   m.tank_treading_rate = std::abs(phase[last] - phase[first]) / span;
   if (m.inclination_turn > std::numbers::pi) {
     m.mode = "tumbling";
+    const double sense = inclination[last] < inclination[first] ? -1.0 : 1.0;
+    double level = inclination[first] + sense * std::numbers::pi, t_last_turn = t[first];
+    int turns = 0;
+    for (std::size_t k = first + 1; k <= last; ++k)
+      while ((inclination[k] - level) * sense >= 0) {  // crossed: interpolate the time
+        const double s = (level - inclination[k - 1]) / (inclination[k] - inclination[k - 1]);
+        t_last_turn = t[k - 1] + s * (t[k] - t[k - 1]);
+        ++turns, level += sense * std::numbers::pi;
+      }
     const double turn = std::abs(inclination[last] - inclination[first]);
-    if (turn > 0) m.tumbling_period = std::numbers::pi * span / turn;
+    if (turns > 0)
+      m.tumbling_period = (t_last_turn - t[first]) / turns;
+    else if (turn > 0)
+      m.tumbling_period = std::numbers::pi * span / turn;
   } else {
     m.mode = m.inclination_reversals > 0 ? "oscillating_tank_treading" : "steady_tank_treading";
   }

@@ -15,7 +15,9 @@
 //   steady_tank_treading       otherwise.
 // Rates over the window t >= t_from: tank-treading angular rate |phi(end) - phi(from)| / (end - from)
 // (so T = 2 pi / rate, thesis ch. 3 f = 4 pi/(k T) = 2 rate/k, ch. 4 f/k = rate/k), and for a
-// tumbling capsule the period of a half-turn of theta, pi (end - from) / |theta(end) - theta(from)|
+// tumbling capsule the period of a half-turn of theta: (t_N - from) / N, t_n the time theta
+// first reaches theta(from) -/+ n pi (exact for a periodic orbit whatever its phase at `from`),
+// or pi (end - from) / |theta(end) - theta(from)| when the window holds no whole half-turn
 // (Jeffery 1922: pi (1 + r^2)/r for a rigid ellipse of aspect ratio r, thesis eq. 3.11).
 #pragma once
 
