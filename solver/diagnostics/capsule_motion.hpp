@@ -13,8 +13,10 @@
 //                              swing of 2 degrees peak to peak): a monotone approach to the
 //                              steady inclination, however fast, is not an oscillation;
 //   steady_tank_treading       otherwise.
-// Rates over the window t >= t_from: tank-treading angular rate |phi(end) - phi(from)| / (end - from)
-// (so T = 2 pi / rate, thesis ch. 3 f = 4 pi/(k T) = 2 rate/k, ch. 4 f/k = rate/k), and for a
+// Rates over the window t >= t_from: the tracked node's mean angular rate about the centroid,
+// |phi(end) - phi(from)| / (end - from) (biased when the window is shorter than a revolution,
+// since the node turns unevenly around a deformed contour: the scene takes the tank-treading
+// frequency from the tangential membrane velocity instead, see Scene::tank_treading_period), and for a
 // tumbling capsule the period of a half-turn of theta: (t_N - from) / N, t_n the time theta
 // first reaches theta(from) -/+ n pi (exact for a periodic orbit whatever its phase at `from`),
 // or pi (end - from) / |theta(end) - theta(from)| when the window holds no whole half-turn
@@ -50,7 +52,7 @@ struct CapsuleMotion {
   double inclination_turn = 0;            ///< max - min of theta over the whole run (rad)
   double inclination_amplitude = 0;       ///< (max - min)/2 of theta over the window (rad)
   int inclination_reversals = 0;          ///< turns of theta by more than 2 x threshold in the window
-  double tank_treading_rate = 0;          ///< |d phi/dt| averaged over the window (rad per 1/k)
+  double tank_treading_rate = 0;          ///< |d phi/dt| averaged over the window (rad per 1/k); see above
   std::optional<double> tumbling_period;  ///< time of a half-turn of theta (1/k), when tumbling
 };
 

@@ -61,6 +61,8 @@ class Capsule {
   const membrane::Membrane<D>& membrane() const { return *membrane_; }
   /// Membrane forces on the fluid of the last step (lattice units).
   std::span<const Vec<D>> forces() const { return F_; }
+  /// Node velocities of the last advect() (lattice units).
+  std::span<const Vec<D>> velocities() const { return U_; }
 
   /// Calls g(linear index) for every node of the stencils of the last spread() (with repeats).
   template <class G>

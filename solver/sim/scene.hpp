@@ -445,15 +445,17 @@ class Scene {
       } else {
         throw core::InputError(spec_.source_file, "/outputs/series/quantities", q,
                                "one of drag_coefficient, lift_coefficient, taylor_deformation, inclination, "
-                               "area_change, tank_treading_phase, mass, kinetic_energy");
+                               "area_change, tank_treading_phase, tank_treading_period, mass, kinetic_energy");
       }
     }
   }
 
   static bool is_capsule_quantity(const std::string& q) {
-    return q == "taylor_deformation" || q == "inclination" || q == "area_change" || q == "tank_treading_phase";
+    return q == "taylor_deformation" || q == "inclination" || q == "area_change" || q == "tank_treading_phase" ||
+           q == "tank_treading_period";
   }
   static std::string capsule_unit(const std::string& q) {
+    if (q == "tank_treading_period") return "1/k";
     return q == "inclination" || q == "tank_treading_phase" ? "rad" : "1";
   }
   static std::string capsule_definition(const std::string& q) {
@@ -464,6 +466,9 @@ class Scene {
       return "angle of the major axis of that ellipse from the x axis, continuous in time (tumbling keeps "
              "decreasing); counter-clockwise positive";
     if (q == "area_change") return "enclosed area over its initial value, minus 1";
+    if (q == "tank_treading_period")
+      return "T = sum over segments of length / |tangential membrane velocity|: the time a node takes to go once "
+             "around the current contour (exact for a steady tank-treading shape)";
     return "angle of membrane node 0 about the centroid, continuous in time (tank-treading: decreasing)";
   }
   double capsule_value(std::size_t c, const std::string& q) const {
@@ -471,7 +476,24 @@ class Scene {
     if (q == "taylor_deformation") return tr.shape.taylor;
     if (q == "inclination") return tr.theta;
     if (q == "area_change") return tr.shape.area / tr.area0 - 1.0;
+    if (q == "tank_treading_period") return tank_treading_period(capsules_[c]);
     return tr.phi;
+  }
+
+  /// sum_i l_i / |v_t,i| over the segments of the contour, v_t the tangential component of the
+  /// mean node velocity of the segment, in k a (so T is in 1/k).
+  double tank_treading_period(const Capsule<D>& c) const {
+    const auto X = c.positions();
+    const auto U = c.velocities();
+    double period = 0;
+    for (std::size_t i = 0; i < X.size(); ++i) {
+      const std::size_t j = i + 1 == X.size() ? 0 : i + 1;
+      const Vec<D> d = X[j] - X[i];
+      const double l = d.norm();
+      const double v_t = 0.5 * (U[i] + U[j]).dot(d) / l / units_.velocity_lu;
+      period += l / std::abs(v_t);
+    }
+    return period;
   }
 
   void sample(double t, std::vector<double>& row) {
@@ -696,14 +718,18 @@ class Scene {
             {"value", *motion.tumbling_period},
             {"unit", "1/k"},
             {"definition", "time for the inclination to turn through pi, averaged" + window}};
-    } else {
+    } else if (const auto* period = column("tank_treading_period")) {
+      // From the tangential membrane velocity, not from the tracked node's phase: the phase
+      // turns unevenly around a deformed contour, so its mean rate over a window shorter than
+      // a revolution (about 20/k) is biased.
+      const double T_tt = diagnostics::analyse_signal(t, *period, from).mean;
       metrics[prefix + "tank_treading_frequency"] = {
-          {"value", 2.0 * motion.tank_treading_rate},
+          {"value", 4.0 * std::numbers::pi / T_tt},
           {"unit", "1"},
-          {"definition", "f = 4 pi / (k T), T the period of membrane node 0 about the centroid" + window +
-                             " (thesis ch. 3 normalisation; 1 for a rigid circle rotating at k/2)"}};
+          {"definition", "f = 4 pi / (k T), T the tank-treading period (series tank_treading_period) averaged" +
+                             window + " (thesis ch. 3 normalisation; 1 for a rigid circle rotating at k/2)"}};
       metrics[prefix + "tank_treading_frequency_per_k"] = {
-          {"value", motion.tank_treading_rate},
+          {"value", 2.0 * std::numbers::pi / T_tt},
           {"unit", "1"},
           {"definition", "f / k = 2 pi / (k T)" + window + " (thesis ch. 4 normalisation)"}};
     }
