@@ -40,10 +40,9 @@ int reversals(std::span<const double> v, double swing) {
 }  // namespace
 
 CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const double> inclination,
-                                      std::span<const double> phase, double t_from,
-                                      double oscillation_threshold) {
-  CAPLAB_CHECK(t.size() == inclination.size() && t.size() == phase.size(),
-               "capsule motion: time, inclination and phase need the same number of samples");
+                                      double t_from, double oscillation_threshold) {
+  CAPLAB_CHECK(t.size() == inclination.size(),
+               "capsule motion: time and inclination need the same number of samples");
   const std::size_t first = std::lower_bound(t.begin(), t.end(), t_from) - t.begin();
   CAPLAB_CHECK(t.size() >= first + 3, "capsule motion: fewer than 3 samples after the start of the window");
   const std::size_t last = t.size() - 1;
@@ -55,7 +54,6 @@ CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const
   m.inclination_amplitude = 0.5 * (*hi - *lo);
   m.inclination_reversals = reversals(inclination.subspan(first), 2 * oscillation_threshold);
   const double span = t[last] - t[first];
-  m.tank_treading_rate = std::abs(phase[last] - phase[first]) / span;
   if (m.inclination_turn > std::numbers::pi) {
     m.mode = "tumbling";
     const double sense = inclination[last] < inclination[first] ? -1.0 : 1.0;

@@ -1,9 +1,11 @@
-// Motion modes of a capsule in shear flow from its tracked inclination and membrane phase
-// (thesis ch. 3: steady tank-treading, tank-treading with oscillation, tumbling).
+// Motion modes of a capsule in shear flow from its tracked inclination (thesis ch. 3: steady
+// tank-treading, tank-treading with oscillation, tumbling).
 //
-// Inputs are continuous (unwrapped) angles: the inclination theta(t) of the major axis of
-// the equivalent ellipse (defined modulo pi, unwrapped by AngleUnwrapper(pi)) and the phase
-// phi(t) of one tracked membrane node about the centroid (modulo 2 pi).
+// Input is the continuous (unwrapped) inclination theta(t) of the major axis of the
+// equivalent ellipse (defined modulo pi, unwrapped by AngleUnwrapper(pi)). The tank-treading
+// frequency is not measured here but from the tangential membrane velocity
+// (Scene::tank_treading_period): a tracked node's phase turns unevenly around a deformed
+// contour, so its mean rate over a window shorter than a revolution is biased.
 //
 // Classification (times in 1/k):
 //   tumbling                   the inclination turns through more than pi over the run (the
@@ -13,14 +15,10 @@
 //                              swing of 2 degrees peak to peak): a monotone approach to the
 //                              steady inclination, however fast, is not an oscillation;
 //   steady_tank_treading       otherwise.
-// Rates over the window t >= t_from: the tracked node's mean angular rate about the centroid,
-// |phi(end) - phi(from)| / (end - from) (biased when the window is shorter than a revolution,
-// since the node turns unevenly around a deformed contour: the scene takes the tank-treading
-// frequency from the tangential membrane velocity instead, see Scene::tank_treading_period), and for a
-// tumbling capsule the period of a half-turn of theta: (t_N - from) / N, t_n the time theta
-// first reaches theta(from) -/+ n pi (exact for a periodic orbit whatever its phase at `from`),
-// or pi (end - from) / |theta(end) - theta(from)| when the window holds no whole half-turn
-// (Jeffery 1922: pi (1 + r^2)/r for a rigid ellipse of aspect ratio r, thesis eq. 3.11).
+// For a tumbling capsule, over the window t >= t_from, the period of a half-turn of theta: (t_N - from) / N,
+// t_n the time theta first reaches theta(from) -/+ n pi (exact for a periodic orbit whatever its phase at
+// `from`), or pi (end - from) / |theta(end) - theta(from)| when the window holds no whole half-turn (Jeffery
+// 1922: pi (1 + r^2)/r for a rigid ellipse of aspect ratio r, thesis eq. 3.11).
 #pragma once
 
 #include <numbers>
@@ -52,7 +50,6 @@ struct CapsuleMotion {
   double inclination_turn = 0;            ///< max - min of theta over the whole run (rad)
   double inclination_amplitude = 0;       ///< (max - min)/2 of theta over the window (rad)
   int inclination_reversals = 0;          ///< turns of theta by more than 2 x threshold in the window
-  double tank_treading_rate = 0;          ///< |d phi/dt| averaged over the window (rad per 1/k); see above
   std::optional<double> tumbling_period;  ///< time of a half-turn of theta (1/k), when tumbling
 };
 
@@ -61,7 +58,7 @@ inline constexpr double default_oscillation_threshold = std::numbers::pi / 180;
 /// Classifies the motion from theta(t), phi(t) sampled at t (strictly increasing). Throws
 /// core::Error when fewer than 3 samples lie in t >= t_from or the lengths differ.
 CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const double> inclination,
-                                      std::span<const double> phase, double t_from,
+                                      double t_from,
                                       double oscillation_threshold = default_oscillation_threshold);
 
 }  // namespace caplab::diagnostics

@@ -700,9 +700,8 @@ class Scene {
           {"value", worst}, {"unit", "1"}, {"definition", "largest |A/A0 - 1| of the enclosed area over the run"}};
     }
     const auto* theta = column("inclination");
-    const auto* phi = column("tank_treading_phase");
-    if (!theta || !phi) return;
-    const auto motion = diagnostics::classify_capsule_motion(t, *theta, *phi, from);
+    if (!theta) return;
+    const auto motion = diagnostics::classify_capsule_motion(t, *theta, from);
     metrics[prefix + "mode"] = {
         {"value", motion.mode},
         {"unit", ""},

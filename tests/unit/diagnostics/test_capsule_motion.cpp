@@ -16,16 +16,15 @@ namespace {
 constexpr double pi = std::numbers::pi;
 
 struct Signals {
-  std::vector<double> t, theta, phi;
+  std::vector<double> t, theta;
 };
 
-template <class Theta, class Phi>
-Signals sample(double end, double dt, Theta&& theta, Phi&& phi) {
+template <class Theta>
+Signals sample(double end, double dt, Theta&& theta) {
   Signals s;
   for (double t = 0; t <= end + 1e-12; t += dt) {
     s.t.push_back(t);
     s.theta.push_back(theta(t));
-    s.phi.push_back(phi(t));
   }
   return s;
 }
@@ -52,21 +51,17 @@ TEST(AngleUnwrapper, FollowsAnAxisThroughManyTurns) {
 }
 
 TEST(CapsuleMotion, SteadyTankTreading) {
-  const auto s = sample(
-      10, 0.01, [](double t) { return pi / 4 - 0.2 * (1 - std::exp(-t)); },
-      [](double t) { return -0.4 * t; });
-  const auto m = classify_capsule_motion(s.t, s.theta, s.phi, 6);
+  const auto s = sample(10, 0.01, [](double t) { return pi / 4 - 0.2 * (1 - std::exp(-t)); });
+  const auto m = classify_capsule_motion(s.t, s.theta, 6);
   EXPECT_EQ(m.mode, "steady_tank_treading");
-  EXPECT_NEAR(m.tank_treading_rate, 0.4, 1e-12);
   EXPECT_FALSE(m.tumbling_period.has_value());
 }
 
 TEST(CapsuleMotion, FastMonotoneApproachIsSteady) {
   // 10 degrees of drift inside the window, but no reversal: still the transient of a steady
   // tank-treader (e.g. a short grid-study run), not an oscillation.
-  const auto s = sample(
-      4, 0.01, [](double t) { return 0.4 + 0.35 * std::exp(-t); }, [](double t) { return -0.3 * t; });
-  const auto m = classify_capsule_motion(s.t, s.theta, s.phi, 1.0);
+  const auto s = sample(4, 0.01, [](double t) { return 0.4 + 0.35 * std::exp(-t); });
+  const auto m = classify_capsule_motion(s.t, s.theta, 1.0);
   EXPECT_GT(m.inclination_amplitude, 3 * pi / 180);
   EXPECT_EQ(m.inclination_reversals, 0);
   EXPECT_EQ(m.mode, "steady_tank_treading");
@@ -74,44 +69,38 @@ TEST(CapsuleMotion, FastMonotoneApproachIsSteady) {
 
 TEST(CapsuleMotion, OscillatingTankTreading) {
   const double amp = 3 * pi / 180;  // 3 degrees, above the 1 degree threshold
-  const auto s = sample(
-      20, 0.01, [&](double t) { return 0.3 + amp * std::sin(2 * t); }, [](double t) { return -0.5 * t; });
-  const auto m = classify_capsule_motion(s.t, s.theta, s.phi, 5);
+  const auto s = sample(20, 0.01, [&](double t) { return 0.3 + amp * std::sin(2 * t); });
+  const auto m = classify_capsule_motion(s.t, s.theta, 5);
   EXPECT_EQ(m.mode, "oscillating_tank_treading");
   EXPECT_NEAR(m.inclination_amplitude, amp, 1e-4);
   EXPECT_GE(m.inclination_reversals, 8);  // sin(2t) over t in [5, 20]: 9 extremes, 8 turns between them
   // The same signal with a 0.5 degree wobble is steady.
-  const auto small = sample(
-      20, 0.01, [&](double t) { return 0.3 + amp / 6 * std::sin(2 * t); }, [](double t) { return -0.5 * t; });
-  EXPECT_EQ(classify_capsule_motion(small.t, small.theta, small.phi, 5).mode, "steady_tank_treading");
+  const auto small = sample(20, 0.01, [&](double t) { return 0.3 + amp / 6 * std::sin(2 * t); });
+  EXPECT_EQ(classify_capsule_motion(small.t, small.theta, 5).mode, "steady_tank_treading");
 }
 
 TEST(CapsuleMotion, JefferyOrbitTumblesWithItsPeriod) {
   const double r = 2;
   const double half_period = pi * (1 + r * r) / r;  // 7.854 for r = 2
   // Window over exactly two half-turns, so the mean rate is exact.
-  const auto s = sample(
-      3 * half_period, 1e-3, [&](double t) { return jeffery(t, r); },
-      [&](double t) { return jeffery(t, r); });
-  const auto m = classify_capsule_motion(s.t, s.theta, s.phi, half_period);
+  const auto s = sample(3 * half_period, 1e-3, [&](double t) { return jeffery(t, r); });
+  const auto m = classify_capsule_motion(s.t, s.theta, half_period);
   EXPECT_EQ(m.mode, "tumbling");
   ASSERT_TRUE(m.tumbling_period.has_value());
   EXPECT_NEAR(*m.tumbling_period, half_period, 1e-3 * half_period);
   EXPECT_GT(m.inclination_turn, 2 * pi);
   // A window of 1.15 half-turns starting at an arbitrary phase: the mean rate over it is off
   // by several percent, the half-turn crossing is not.
-  const auto w = sample(
-      2.3 * half_period, 1e-3, [&](double t) { return jeffery(t, r); },
-      [&](double t) { return jeffery(t, r); });
-  const auto p = classify_capsule_motion(w.t, w.theta, w.phi, 1.15 * half_period);
+  const auto w = sample(2.3 * half_period, 1e-3, [&](double t) { return jeffery(t, r); });
+  const auto p = classify_capsule_motion(w.t, w.theta, 1.15 * half_period);
   ASSERT_TRUE(p.tumbling_period.has_value());
   EXPECT_NEAR(*p.tumbling_period, half_period, 1e-3 * half_period);
 }
 
 TEST(CapsuleMotion, RejectsShortOrMismatchedInput) {
   const std::vector<double> t{0, 1, 2, 3}, a{0, 0, 0, 0}, shorter{0, 0, 0};
-  EXPECT_THROW(classify_capsule_motion(t, a, shorter, 0), core::Error);
-  EXPECT_THROW(classify_capsule_motion(t, a, a, 2.5), core::Error);
+  EXPECT_THROW(classify_capsule_motion(t, shorter, 0), core::Error);
+  EXPECT_THROW(classify_capsule_motion(t, a, 2.5), core::Error);
 }
 
 }  // namespace
