@@ -12,6 +12,7 @@
 #include "bench/fluid_throughput.hpp"
 #include "bench/stream_bandwidth.hpp"
 #include "core/error.hpp"
+#include "core/threads.hpp"
 #include "io/manifest.hpp"
 #include "io/run_directory.hpp"
 
@@ -117,6 +118,7 @@ json run_benchmarks(const BenchOptions& options) {
   result["schema"] = "caplab.bench/1";
   result["environment"] = io::environment_json(max_threads);
   result["environment"]["omp_num_procs"] = omp_get_num_procs();
+  result["environment"]["usable_processors"] = core::usable_processors();
   result["load_average"] = {{"start", load_average()}};
   result["options"] = {{"threads", opt.threads},
                        {"size_d2q9", opt.size_d2q9},
@@ -129,10 +131,11 @@ json run_benchmarks(const BenchOptions& options) {
                        {"precisions", opt.precisions},
                        {"two_level", opt.two_level},
                        {"quick", opt.quick}};
-  if (max_threads > omp_get_num_procs())
+  if (max_threads > core::usable_processors())
     result["warnings"].push_back(
-        fmt::format("{} threads on {} processors: oversubscribed, timings are not meaningful", max_threads,
-                    omp_get_num_procs()));
+        fmt::format("{} threads on {} usable processors (affinity and CPU quota): oversubscribed, timings are "
+                    "not meaningful",
+                    max_threads, core::usable_processors()));
 
   result["environment"]["llc_bytes_reported"] = llc_bytes();
   if ((opt.stream_array_mib << 20) < llc_bytes())

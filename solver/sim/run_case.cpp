@@ -1,7 +1,6 @@
 #include "sim/run_case.hpp"
 
-#include <omp.h>
-
+#include "core/threads.hpp"
 #include "io/manifest.hpp"
 #include "lattice/lattice.hpp"
 
@@ -38,8 +37,7 @@ std::string supported_combinations() { return "dimension 2 (D2Q9) or 3 (D3Q19) Ã
 
 RunResult run_case(const cases::CaseSpec& spec, const std::filesystem::path& out, const ProgressFn& progress) {
   const LatticeUnits units = derive_units(spec);  // input errors surface before the directory exists
-  if (spec.numerics.threads > 0) omp_set_num_threads(spec.numerics.threads);
-  const int threads = omp_get_max_threads();
+  const int threads = core::apply_thread_count(spec.numerics.threads);
   auto dir = io::RunDirectory::create(out, /*overwrite=*/true);
   nlohmann::json resolved = spec.resolved;
   resolved["fidelity_applied"] = spec.fidelity;

@@ -3,8 +3,12 @@
 // vortex field crossing the interface is conserved to a small drift.
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
 #include <cmath>
+#include <memory>
 #include <numbers>
+#include <vector>
 
 #include "flow_harness.hpp"
 
@@ -121,22 +125,30 @@ TEST(TwoLevel, LinearShearTrtNonlinearResidualOnly) {
   EXPECT_GT(e1 / e2, 8.0);
 }
 
-TEST(TwoLevel, MassOfVortexCrossingInterface) {
-  using L = lattice::D2Q9;
+using VortexFluid = sim::Fluid<lattice::D2Q9, double, collision::Bgk>;
+
+/// A Taylor–Green field advected by a uniform flow on two blocks: vortices cross the interface.
+std::unique_ptr<VortexFluid> vortex_fluid() {
   auto [c, f] = two_blocks<2>({32, 32}, Vec<2>::Zero(), 10, 22);
-  sim::Fluid<L, double, collision::Bgk>::Setup s;
+  VortexFluid::Setup s;
   s.coarse = c;
   s.fine = f;
   s.boundaries = {Kind::periodic, Kind::periodic};
   s.imposed_velocity_lu = [](const Vec<2>&) { return Vec<2>::Zero(); };
   s.coarse_op = collision::Bgk{0.6};
-  sim::Fluid<L, double, collision::Bgk> fluid(s);
+  auto fluid = std::make_unique<VortexFluid>(s);
   const double kw = 2 * std::numbers::pi / 32, u0 = 0.02;
-  fluid.initialise([&](const Vec<2>& x) {
-    // A Taylor–Green field advected by a uniform flow: vortices cross the interface.
+  fluid->initialise([&](const Vec<2>& x) {
     Vec<2> u(0.03 - u0 * std::cos(kw * x[0]) * std::sin(kw * x[1]), u0 * std::sin(kw * x[0]) * std::cos(kw * x[1]));
     return std::pair{1.0, u};
   });
+  return fluid;
+}
+
+TEST(TwoLevel, MassOfVortexCrossingInterface) {
+  using L = lattice::D2Q9;
+  const auto owned = vortex_fluid();
+  auto& fluid = *owned;
   // Mass of the domain: uncovered coarse nodes (area 1) plus fine nodes (area 1/4),
   // the fine nodes next to the ghost ring counted as in the overlap.
   auto total = [&] {
@@ -162,6 +174,33 @@ TEST(TwoLevel, MassOfVortexCrossingInterface) {
   const double drift = std::abs(total() / m0 - 1.0);
   RecordProperty("relative_mass_drift", std::to_string(drift));
   EXPECT_LT(drift, 1e-4);
+}
+
+// The tests run on one OpenMP thread (tests/CMakeLists.txt); this one checks that the threaded
+// kernels, the two-level transfers included, give the same populations bit for bit.
+TEST(TwoLevel, PopulationsDoNotDependOnThreadCount) {
+  auto populations_after_steps = [](int threads) {
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    const auto fluid = vortex_fluid();
+    for (int t = 0; t < 60; ++t) fluid->step();
+    omp_set_num_threads(saved);
+    std::vector<double> all;
+    for (std::size_t b = 0; b < fluid->block_count(); ++b) {
+      const auto& pop = fluid->block(b).pop;
+      const auto& g = pop.grid();
+      field::for_each_interior<2>(g, [&](const Index<2>& ijk) {
+        for (int i = 0; i < lattice::D2Q9::q; ++i) all.push_back(pop(i, g.index(ijk)));
+      });
+    }
+    return all;
+  };
+  const auto one = populations_after_steps(1);
+  const auto three = populations_after_steps(3);
+  ASSERT_EQ(one.size(), three.size());
+  std::size_t differing = 0;
+  for (std::size_t n = 0; n < one.size(); ++n) differing += one[n] != three[n];
+  EXPECT_EQ(differing, 0U);
 }
 
 }  // namespace
