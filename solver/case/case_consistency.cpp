@@ -19,6 +19,11 @@ namespace {
 using nlohmann::json;
 
 constexpr const char* axis_names[] = {"x", "y", "z"};
+// A prescribed path must start at shape.center / shape.angle and join its segments to this
+// (absolute, in L or radians; relative for values above 1).
+constexpr double kinematic_tolerance = 1e-9;
+// Times at which a moving body's path is checked against the domain and the fine region.
+constexpr int path_samples = 4000;
 
 // True when x/step is a whole number (within the relative tolerance); `n` gets the nearest one.
 bool is_multiple(double x, double step, double& n) {
@@ -125,10 +130,10 @@ void check_body_kind(const BodySpec& body, const std::string& at, int dimension,
     diag.fail(at + "/shape/type", json(enum_name(shape_type_names, body.shape.type)),
               fmt::format("a {}D shape for body \"{}\" since physics.dimension is {}: {}", dimension, body.name,
                           dimension, dimension == 2 ? "\"circle\", \"ellipse\" or \"biconcave\"" : "\"sphere\""));
-  if (body.motion && body.shape.type != ShapeSpec::Type::circle && body.shape.type != ShapeSpec::Type::sphere)
+  if (body.motion && body.shape.type == ShapeSpec::Type::biconcave)
     diag.fail(at + "/shape/type", json(enum_name(shape_type_names, body.shape.type)),
-              fmt::format("\"circle\" or \"sphere\" for the rigid body \"{}\" (ellipses and biconcave shapes "
-                          "are capsule shapes so far)",
+              fmt::format("\"circle\", \"ellipse\" or \"sphere\" for the rigid body \"{}\" (the biconcave shape "
+                          "is a capsule shape)",
                           body.name));
   if (body.membrane && dimension != 2)
     diag.fail(at + "/membrane", json("a membrane in 3D"),
@@ -152,11 +157,94 @@ void check_membrane_resolution(const BodySpec& body, const std::string& at, doub
                           body.name, body.membrane->nodes, spacing, max_membrane_spacing_fine));
 }
 
-void check_bodies(const CaseSpec& spec, const CaseDiagnostics& diag) {
+// A prescribed motion starts where the shape is and never jumps: the centre at t = 0 is
+// shape.center, the orientation shape.angle, and each breakpoint joins its pieces.
+void check_motion_start(const BodySpec& body, const std::string& at, const CaseDiagnostics& diag) {
+  const auto& k = *body.motion->kinematics;
+  const auto start = k.at(0.0);
+  const std::string motion_at = at + "/motion/segments";
+  for (std::size_t a = 0; a < body.shape.center.size(); ++a)
+    if (!(std::abs(start.x[a] - body.shape.center[a]) <= kinematic_tolerance))
+      diag.fail(motion_at, json(k.position()[a].pieces().front().text()),
+                fmt::format("a path of body \"{}\" that starts at its shape.center: at t = 0 the {} position is "
+                            "{:.10g}, shape.center has {:.10g}; change one of them",
+                            body.name, axis_names[a], start.x[a], body.shape.center[a]));
+  if (!(std::abs(start.angle - body.shape.angle) <= kinematic_tolerance))
+    diag.fail(motion_at, json(k.angle().pieces().front().text()),
+              fmt::format("an orientation of body \"{}\" that starts at its shape.angle: at t = 0 the angle is "
+                          "{:.10g} rad, shape.angle is {:.10g}; set shape.angle to the angle at t = 0",
+                          body.name, start.angle, body.shape.angle));
+  auto check_joins = [&](const expr::Piecewise& f, const std::string& what) {
+    const auto& bp = f.breakpoints();
+    for (std::size_t j = 0; j < bp.size(); ++j) {
+      const double before = f.pieces()[j].value(bp[j]), after = f.pieces()[j + 1].value(bp[j]);
+      if (!(std::abs(after - before) <= kinematic_tolerance * std::max(1.0, std::abs(before))))
+        diag.fail(fmt::format("{}/{}", motion_at, j + 1), json(f.pieces()[j + 1].text()),
+                  fmt::format("the {} of body \"{}\" continuous at t = {}: the segment before ends at {:.10g}, "
+                              "this one starts at {:.10g} (a jump would move the body in one step)",
+                              what, body.name, bp[j], before, after));
+    }
+  };
+  for (std::size_t a = 0; a < k.position().size(); ++a) check_joins(k.position()[a], std::string(axis_names[a]) + " position");
+  check_joins(k.angle(), "orientation");
+}
+
+// The body stays inside the domain and, with two levels, inside the fine region with the IB
+// margin, over the whole run: the path is sampled at `path_samples` times and at every
+// breakpoint. A fixed body is one sample.
+void check_path(const CaseSpec& spec, const BodySpec& body, const std::string& at, const CaseDiagnostics& diag) {
   const PhysicsSpec& physics = spec.physics;
   const GridSpec& grid = spec.numerics.grid;
   const bool two_level = grid.refinement == GridSpec::Refinement::two_level;
   const double margin = body_margin_fine * grid.fine_spacing;
+  const double r = circumscribed_radius(body.shape);
+  std::vector<double> times{0.0};
+  if (body.is_moving()) {
+    const double end = spec.numerics.end_time;
+    for (int i = 1; i <= path_samples; ++i) times.push_back(end * i / path_samples);
+    for (double b : body.motion->kinematics->angle().breakpoints())
+      if (b > 0 && b < end) times.push_back(b);
+  }
+  const std::string where_at = body.is_moving() ? at + "/motion/segments" : at + "/shape/center";
+  for (double t : times) {
+    std::vector<double> c = body.shape.center;
+    if (body.is_moving()) {
+      const auto pose = body.motion->kinematics->at(t);
+      for (std::size_t a = 0; a < c.size(); ++a) c[a] = pose.x[a];
+      const bool finite = std::all_of(c.begin(), c.end(), [](double x) { return std::isfinite(x); }) &&
+                          std::isfinite(pose.angle) && std::isfinite(pose.omega) &&
+                          std::all_of(pose.v.begin(), pose.v.end(), [](double x) { return std::isfinite(x); });
+      if (!finite)
+        diag.fail_text(where_at, fmt::format("a path that is not finite at t = {:.6g}", t),
+                       fmt::format("formulas of body \"{}\" that are finite, with finite derivatives, over the whole "
+                                   "run [0, {}]",
+                                   body.name, spec.numerics.end_time));
+    }
+    const std::string when = body.is_moving() ? fmt::format(" at t = {:.6g}", t) : "";
+    for (std::size_t a = 0; a < c.size(); ++a) {
+      const double lo = c[a] - r, hi = c[a] + r;
+      if (!(lo > 0 && hi < physics.domain_size[a]))
+        diag.fail(where_at, body.is_moving() ? json(fmt::format("centre {:.6g}", c[a])) : json(body.shape.center),
+                  fmt::format("body \"{}\" (reaching {:.4g} from its centre) inside the domain, but{} along {} it "
+                              "spans [{:.4g}, {:.4g}], not inside (0, {})",
+                              body.name, r, when, axis_names[a], lo, hi, physics.domain_size[a]));
+      if (!two_level) continue;
+      const double min = grid.fine_min[a] + margin, max = grid.fine_max[a] - margin;
+      if (!(lo >= min && hi <= max))
+        diag.fail(
+            where_at, body.is_moving() ? json(fmt::format("centre {:.6g}", c[a])) : json(body.shape.center),
+            fmt::format(
+                "body \"{}\" (reaching {:.4g} from its centre) inside the fine region with a margin of at least {} "
+                "fine spacings ({}, the IB kernel support), i.e. within [{}, {}] along {}; it spans [{:.4g}, "
+                "{:.4g}]{}",
+                body.name, r, body_margin_fine, margin, min, max, axis_names[a], lo, hi, when));
+    }
+  }
+}
+
+void check_bodies(const CaseSpec& spec, const CaseDiagnostics& diag) {
+  const PhysicsSpec& physics = spec.physics;
+  const GridSpec& grid = spec.numerics.grid;
   std::set<std::string> names;
   for (std::size_t i = 0; i < physics.bodies.size(); ++i) {
     const BodySpec& body = physics.bodies[i];
@@ -166,24 +254,8 @@ void check_bodies(const CaseSpec& spec, const CaseDiagnostics& diag) {
     check_body_kind(body, at, physics.dimension, diag);
     if (body.membrane) check_membrane_resolution(body, at, grid.fine_spacing, diag);
 
-    const double r = circumscribed_radius(body.shape);
-    for (std::size_t a = 0; a < body.shape.center.size(); ++a) {
-      const double lo = body.shape.center[a] - r, hi = body.shape.center[a] + r;
-      if (!(lo > 0 && hi < physics.domain_size[a]))
-        diag.fail(at + "/shape/center", json(body.shape.center),
-                  fmt::format("body \"{}\" (reaching {:.4g} from its centre) inside the domain, but along {} it "
-                              "spans [{:.4g}, {:.4g}], not inside (0, {})",
-                              body.name, r, axis_names[a], lo, hi, physics.domain_size[a]));
-      if (!two_level) continue;
-      const double min = grid.fine_min[a] + margin, max = grid.fine_max[a] - margin;
-      if (!(lo >= min && hi <= max))
-        diag.fail(
-            at + "/shape/center", json(body.shape.center),
-            fmt::format(
-                "body \"{}\" (reaching {:.4g} from its centre) inside the fine region with a margin of at least {} "
-                "fine spacings ({}, the IB kernel support), i.e. within [{}, {}] along {}; it spans [{:.4g}, {:.4g}]",
-                body.name, r, body_margin_fine, margin, min, max, axis_names[a], lo, hi));
-    }
+    if (body.is_moving()) check_motion_start(body, at, diag);
+    check_path(spec, body, at, diag);
   }
 }
 

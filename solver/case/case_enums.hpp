@@ -46,7 +46,8 @@ inline constexpr std::array reference_curvature_names{
     EnumName<MembraneSpec::ReferenceCurvature>{"flat", MembraneSpec::ReferenceCurvature::flat}};
 
 inline constexpr std::array motion_type_names{
-    EnumName<RigidMotionSpec::Type>{"fixed", RigidMotionSpec::Type::fixed}};
+    EnumName<RigidMotionSpec::Type>{"fixed", RigidMotionSpec::Type::fixed},
+    EnumName<RigidMotionSpec::Type>{"prescribed", RigidMotionSpec::Type::prescribed}};
 
 inline constexpr std::array refinement_names{
     EnumName<GridSpec::Refinement>{"uniform", GridSpec::Refinement::uniform},

@@ -101,7 +101,12 @@ SchemaNode build_case_schema() {
                            opt("aspect_ratio", number(at_least(1))),  // ellipse only
                            opt("alpha", number(positive)),            // biconcave only
                            opt("angle", number())})),                 // 2D only
-      opt("motion", object({req("type", choice(enum_names(motion_type_names)))})),
+      // prescribed only: "segments" (required there), "parameters" (case_consistency.cpp).
+      opt("motion", object({req("type", choice(enum_names(motion_type_names))),
+                            opt("parameters", map_of(number())),
+                            opt("segments", array_of(object({opt("until", number()),
+                                                             req("position", per_axis(text())),
+                                                             opt("angle", text())})))})),
       opt("membrane", object({req("law", choice(enum_names(membrane_law_names))),
                               req("capillary", number(positive)), opt("bending_ratio", number(at_least(0))),
                               opt("reference_curvature", choice(enum_names(reference_curvature_names))),
@@ -181,6 +186,52 @@ const std::vector<ConditionalKey>& conditional_keys() {
       {"/numerics/collision/magic", "/numerics/collision/operator", {"trt"}, false},
   };
   return rules;
+}
+
+// Per rigid body: "prescribed" motion needs a non-empty "segments" list in which every segment
+// but the last ends at an "until" time, strictly increasing; "fixed" takes neither "segments"
+// nor "parameters".
+void check_motion_entries(const json& doc, const CaseDiagnostics& diag) {
+  const json& bodies = doc.at("physics").at("bodies");
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (!bodies[i].contains("motion")) continue;
+    const json& motion = bodies[i].at("motion");
+    const std::string base = child_pointer(child_pointer("/physics/bodies", i), "motion");
+    const bool prescribed = motion.at("type").get_ref<const std::string&>() == "prescribed";
+    if (!prescribed) {
+      for (const char* key : {"segments", "parameters"})
+        if (motion.contains(key))
+          diag.fail(child_pointer(base, key), motion.at(key),
+                    fmt::format("no \"{}\" key: it applies only when {}/type is \"prescribed\"; remove it or "
+                                "set the type to \"prescribed\"",
+                                key, base));
+      continue;
+    }
+    const std::string segments_at = child_pointer(base, "segments");
+    if (!motion.contains("segments") || motion.at("segments").empty())
+      diag.fail_text(segments_at, "nothing (no motion segments)",
+                     "a non-empty array of segments {\"until\": t_end, \"position\": [x(t), y(t)], \"angle\": "
+                     "theta(t)} when " + base + "/type is \"prescribed\"; the last segment has no \"until\"");
+    const json& segments = motion.at("segments");
+    double previous = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < segments.size(); ++k) {
+      const bool last = k + 1 == segments.size();
+      const std::string until_at = child_pointer(child_pointer(segments_at, k), "until");
+      if (last && segments[k].contains("until"))
+        diag.fail(until_at, segments[k].at("until"),
+                  "no \"until\" on the last segment: it lasts to the end of the run");
+      if (last) break;
+      if (!segments[k].contains("until"))
+        diag.fail_text(until_at, "nothing (required key \"until\" is missing)",
+                       "the time (L/U) at which this segment ends and the next begins");
+      const double until = segments[k].at("until").get<double>();
+      if (!(until > previous))
+        diag.fail(until_at, segments[k].at("until"),
+                  fmt::format("an end time after the previous segment's ({}): segments run in time order",
+                              previous));
+      previous = until;
+    }
+  }
 }
 
 // Per entry: a mode entry has "reference_mode" (a known mode or a non-empty array of them) and
@@ -429,6 +480,7 @@ void check_conditional_keys(const json& doc, const CaseDiagnostics& diag) {
                     " is \"" + control + "\" here; remove it or change " + rule.controller);
   }
   check_acceptance_entries(doc, diag);
+  check_motion_entries(doc, diag);
 }
 
 std::string apply_override(json& doc, std::string_view dotted, json value, const std::string& label,

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "expr/rigid_kinematics.hpp"
+
 namespace caplab::cases {
 
 /// Imposed (unperturbed) flow: initial condition and far-field / wall velocity.
@@ -40,9 +42,15 @@ enum class BoundaryType {
   wall        ///< half-way bounce-back wall moving with the imposed flow's velocity there
 };
 
+/// How a rigid body moves. `prescribed`: time segments, each with the centre per axis and
+/// (2D) the orientation as expressions of t in L/U (expr/expression.hpp), e.g. thesis eq. 2.28
+/// as two segments split at t = 16. The centre at t = 0 is shape.center and the orientation
+/// shape.angle (checked); velocities and accelerations are the exact derivatives.
 struct RigidMotionSpec {
-  enum class Type { fixed };
+  enum class Type { fixed, prescribed };
   Type type = Type::fixed;
+  /// fixed: at rest at shape.center; prescribed: the parsed segments (built by the loader).
+  std::optional<expr::RigidKinematics> kinematics;
 };
 
 struct ShapeSpec {
@@ -74,6 +82,7 @@ struct BodySpec {
   std::string name;
   ShapeSpec shape;
   std::optional<RigidMotionSpec> motion;   ///< rigid bodies
+  bool is_moving() const { return motion && motion->type == RigidMotionSpec::Type::prescribed; }
   std::optional<MembraneSpec> membrane;   ///< capsules
   bool is_capsule() const { return membrane.has_value(); }
 };
@@ -116,7 +125,7 @@ struct NumericsSpec {
   IbSpec ib;
   double lattice_velocity = 0.1;  ///< U in lattice units (same on every block: acoustic scaling)
   double end_time = 1.0;          ///< in L/U
-  int threads = 0;                ///< 0: OpenMP default
+  int threads = 0;                ///< 0: OMP_NUM_THREADS, else the usable processors (CPU quota respected)
 };
 
 struct SeriesSpec {

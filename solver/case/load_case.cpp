@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <limits>
 #include <set>
 
@@ -123,7 +124,45 @@ void apply_set(json& target, const std::string& text, CaseDiagnostics& diag) {
 
 // ---- Conversion to CaseSpec (the document has passed the schema checks). ----
 
-CaseSpec to_spec(const json& doc) {
+/// The kinematics of a body's "motion" (fixed: at rest at shape.center). Expressions that do not
+/// parse are reported at their JSON path with the parser's caret line.
+expr::RigidKinematics kinematics_of(const json& body, const ShapeSpec& shape, const std::string& at,
+                                    const CaseDiagnostics& diag) {
+  const json& motion = body.at("motion");
+  if (motion.at("type").get_ref<const std::string&>() != "prescribed")
+    return expr::RigidKinematics::fixed(shape.center, shape.angle);
+  const auto parameters = motion.value("parameters", std::map<std::string, double>{});
+  const json& segments = motion.at("segments");
+  const std::size_t dimension = shape.center.size();
+  std::vector<double> until;
+  std::vector<std::vector<expr::Expression>> position(dimension);
+  std::vector<expr::Expression> angle;
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    const json& seg = segments[k];
+    const std::string seg_at = child_pointer(child_pointer(at, "segments"), k);
+    auto parse = [&](const std::string& text, const std::string& pointer) {
+      try {
+        return expr::Expression::parse(text, parameters);
+      } catch (const expr::ParseError& e) {
+        diag.fail(pointer, json(text), fmt::format("a formula of t (L/U): {}", e.what()));
+      }
+    };
+    if (seg.contains("until")) until.push_back(seg.at("until").get<double>());
+    for (std::size_t a = 0; a < dimension; ++a)
+      position[a].push_back(parse(seg.at("position").at(a).get<std::string>(),
+                                  child_pointer(child_pointer(seg_at, "position"), a)));
+    if (seg.contains("angle") && dimension != 2)
+      diag.fail(child_pointer(seg_at, "angle"), seg.at("angle"),
+                "no \"angle\" in 3D: rotating 3D bodies are not supported; remove the key");
+    angle.push_back(seg.contains("angle") ? parse(seg.at("angle").get<std::string>(), child_pointer(seg_at, "angle"))
+                                          : parse(fmt::format("{:.17g}", shape.angle), seg_at));
+  }
+  std::vector<expr::Piecewise> x;
+  for (auto& pieces : position) x.emplace_back(until, std::move(pieces));
+  return expr::RigidKinematics(std::move(x), expr::Piecewise(until, std::move(angle)));
+}
+
+CaseSpec to_spec(const json& doc, const CaseDiagnostics& diag) {
   CaseSpec spec;
   spec.id = doc.at("id").get<std::string>();
   spec.title = doc.at("title").get<std::string>();
@@ -151,8 +190,12 @@ CaseSpec to_spec(const json& doc) {
     body.shape.aspect_ratio = b.at("shape").value("aspect_ratio", body.shape.aspect_ratio);
     body.shape.alpha = b.at("shape").value("alpha", body.shape.alpha);
     body.shape.angle = b.at("shape").value("angle", body.shape.angle);
-    if (b.contains("motion"))
-      body.motion = RigidMotionSpec{enum_value(motion_type_names, b.at("motion").at("type").get<std::string>())};
+    if (b.contains("motion")) {
+      RigidMotionSpec motion;
+      motion.type = enum_value(motion_type_names, b.at("motion").at("type").get<std::string>());
+      motion.kinematics = kinematics_of(b, body.shape, child_pointer(child_pointer("/physics/bodies", physics.bodies.size()), "motion"), diag);
+      body.motion = std::move(motion);
+    }
     if (b.contains("membrane")) {
       const json& m = b.at("membrane");
       MembraneSpec membrane;
@@ -303,7 +346,7 @@ CaseSpec parse_case(const json& doc, const std::string& source_name, const std::
   check_conditional_keys(resolved, diag);
   check_axis_lengths(resolved, resolved.at("physics").at("dimension").get<int>(), per_axis, diag);
 
-  CaseSpec spec = to_spec(resolved);
+  CaseSpec spec = to_spec(resolved, diag);
   spec.source_file = source_name;
   spec.fidelity = fidelity;
   check_consistency(spec, levels, diag);

@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 
 #include <numbers>
+#include <optional>
 #include <variant>
 
 #include "case/case_spec.hpp"
@@ -26,6 +27,7 @@
 #include "diagnostics/capsule_motion.hpp"
 #include "diagnostics/shape2d.hpp"
 #include "diagnostics/signal.hpp"
+#include "expr/rigid_kinematics.hpp"
 #include "geometry/closed_curve.hpp"
 #include "geometry/marker_set.hpp"
 #include "ibm/direct_forcing.hpp"
@@ -141,6 +143,13 @@ class Scene {
     Forcing forcing;
     Vec<D> force_on_body_lu = Vec<D>::Zero();
     double coefficient_scale = 1.0;  // 1 / (½ ρ U_lu² A_lu)
+    // Prescribed motion: the markers relative to the centre at the initial orientation, and
+    // what the internal-mass correction needs (ibm/internal_mass.hpp, rigid form).
+    std::optional<expr::RigidKinematics> kinematics;
+    std::vector<Vec<D>> offsets;
+    double angle0 = 0.0;
+    double volume_lu = 0.0;
+    expr::RigidPose pose;
   };
 
   static typename FluidT::Setup make_setup(const cases::CaseSpec& spec, const LatticeUnits& units, const Op& op) {
@@ -183,19 +192,41 @@ class Scene {
         build_capsule(b);
         continue;
       }
-      RigidBody body{b.name, b.shape, {}, {}, {}, make_forcing(), Vec<D>::Zero(), 1.0};
+      RigidBody body;
+      body.name = b.name;
+      body.shape = b.shape;
+      body.forcing = make_forcing();
       Vec<D> c;
       for (int a = 0; a < D; ++a) c[a] = b.shape.center[a];
+      // Coefficients per unit span over the reference length (2D: the diameter, the chord of
+      // an ellipse) or over the frontal area pi D^2/4 (3D).
+      double reference_lu = 0;
       if constexpr (D == 2) {
-        body.markers = geometry::circle_markers(c, b.shape.diameter, spacing);
-        body.coefficient_scale = 1.0 / (0.5 * units_.velocity_lu * units_.velocity_lu * (b.shape.diameter / h));
+        if (b.shape.type == cases::ShapeSpec::Type::ellipse) {
+          const double major = 0.5 * b.shape.diameter * std::sqrt(b.shape.aspect_ratio);
+          body.markers = geometry::ellipse_markers(c, major, 0.25 * b.shape.diameter * b.shape.diameter / major,
+                                                   b.shape.angle, spacing);
+          reference_lu = 2 * major / h;
+        } else {
+          body.markers = geometry::circle_markers(c, b.shape.diameter, spacing);
+          reference_lu = b.shape.diameter / h;
+        }
       } else {
         body.markers = geometry::sphere_markers(c, b.shape.diameter, spacing);
         const double r = 0.5 * b.shape.diameter / h;
-        body.coefficient_scale = 1.0 / (0.5 * units_.velocity_lu * units_.velocity_lu * std::numbers::pi * r * r);
+        reference_lu = std::numbers::pi * r * r;
       }
+      body.coefficient_scale = 1.0 / (0.5 * units_.velocity_lu * units_.velocity_lu * reference_lu);
       for (double w : body.markers.weight) body.weight_lu.push_back(ibm::measure_to_lattice<D>(w, h));
-      body.desired_lu.assign(body.markers.X.size(), Vec<D>::Zero());  // fixed bodies
+      body.desired_lu.assign(body.markers.X.size(), Vec<D>::Zero());  // at rest until moved
+      if (b.is_moving()) {
+        body.kinematics = b.motion->kinematics;
+        body.angle0 = b.shape.angle;
+        for (const auto& X : body.markers.X) body.offsets.push_back(X - c);
+        const double r_eq = 0.5 * b.shape.diameter / h;  // equivalent radius: same area/volume
+        body.volume_lu = D == 2 ? std::numbers::pi * r_eq * r_eq : 4.0 / 3.0 * std::numbers::pi * r_eq * r_eq * r_eq;
+        move_body(body, 0.0);
+      }
       bodies_.push_back(std::move(body));
     }
     if (fluid_.two_level()) {
@@ -296,6 +327,7 @@ class Scene {
     core::timed(seconds_ib_, [&] {
       if (capsules_.empty()) collect_forced_nodes(pop.grid().size());  // move_capsules collected them
     });
+    ++fine_steps_;
     return forced_nodes_;
   }
 
@@ -390,12 +422,17 @@ class Scene {
           },
           b.forcing);
     for (const auto& c : capsules_) c.restore(f, base);
+    const double t = fine_steps_ * units_.blocks.back().dt;
+    for (auto& b : bodies_)
+      if (b.kinematics) move_body(b, t);
     for (auto& b : bodies_) {
       try {
         std::visit(
             [&](auto& forcing) {
               forcing.apply(pop.grid(), periodic_, b.markers.X, b.desired_lu, b.weight_lu, u_star, rho, f);
+              // Moving: plus the inertia of the fluid inside (rigid form, rho = 1), exact a(t).
               b.force_on_body_lu = -forcing.total_force_on_fluid();
+              if (b.kinematics) b.force_on_body_lu += b.volume_lu * acceleration_lu(b.pose);
             },
             b.forcing);
       } catch (const core::NumericalError&) {
@@ -407,6 +444,33 @@ class Scene {
                                    "(TRT, a finer grid, a lower numerics.lattice_velocity, tau further from 1/2)");
       }
     }
+  }
+
+  /// Places the markers of a moving body at time t (L/U) and sets their velocities: centre
+  /// velocity plus omega x r (2D), exact from the kinematics.
+  void move_body(RigidBody& b, double t) const {
+    b.pose = b.kinematics->at(t);
+    Vec<D> c, v;
+    for (int a = 0; a < D; ++a) c[a] = b.pose.x[a], v[a] = b.pose.v[a];
+    const double turn = b.pose.angle - b.angle0, cs = std::cos(turn), sn = std::sin(turn);
+    for (std::size_t m = 0; m < b.offsets.size(); ++m) {
+      Vec<D> r = b.offsets[m];
+      Vec<D> u = v;
+      if constexpr (D == 2) {
+        r = Vec<2>(cs * r[0] - sn * r[1], sn * r[0] + cs * r[1]);
+        u += b.pose.omega * Vec<2>(-r[1], r[0]);
+      }
+      b.markers.X[m] = c + r;
+      b.desired_lu[m] = u * units_.velocity_lu;
+    }
+  }
+
+  /// Centre acceleration in lattice units of the finest block: a (U^2/L) * U_lu^2 * dx (L).
+  Vec<D> acceleration_lu(const expr::RigidPose& p) const {
+    const double scale = units_.velocity_lu * units_.velocity_lu * fluid_.finest().pop.grid().dx();
+    Vec<D> a;
+    for (int k = 0; k < D; ++k) a[k] = p.a[k] * scale;
+    return a;
   }
 
   /// Drag along the flow direction, lift perpendicular to it (in the x–y plane).
@@ -428,10 +492,20 @@ class Scene {
       if (q == "drag_coefficient" || q == "lift_coefficient") {
         if (bodies_.empty())
           throw core::InputError(spec_.source_file, "/outputs/series/quantities", q, "a quantity of a scene with bodies (this case has none)");
+        const std::string over = " / (0.5 rho U^2 D) (2D: per unit span, D the diameter or an ellipse's chord; 3D: "
+                                 "over the area pi D^2/4); moving bodies include the inertia of their inner fluid";
         for (const auto& b : bodies_)
           columns_.push_back({many ? b.name + "." + q : q, "1",
-                              q == "drag_coefficient" ? "C_d = F_drag / (0.5 rho U^2 D) (per unit span in 2D; area pi D^2/4 in 3D)"
-                                                      : "C_l = F_lift / (0.5 rho U^2 D) (per unit span in 2D; area pi D^2/4 in 3D)"});
+                              (q == "drag_coefficient" ? "C_d = F_drag" : "C_l = F_lift") + over});
+      } else if (q == "position") {
+        if (bodies_.empty())
+          throw core::InputError(spec_.source_file, "/outputs/series/quantities", q, "a quantity of a scene with bodies (this case has none)");
+        for (const auto& b : bodies_) {
+          const std::string prefix = many ? b.name + "." : "";
+          for (int a = 0; a < D; ++a)
+            columns_.push_back({prefix + "xyz"[a], "L", "centre of the body along " + std::string(1, "xyz"[a])});
+          if constexpr (D == 2) columns_.push_back({prefix + "angle", "rad", "orientation of the body's long axis from x"});
+        }
       } else if (is_capsule_quantity(q)) {
         if (capsules_.empty())
           throw core::InputError(spec_.source_file, "/outputs/series/quantities", q,
@@ -444,7 +518,7 @@ class Scene {
         columns_.push_back({"kinetic_energy", "rho U^2 L^D", "integral of rho u^2 / 2 over the domain"});
       } else {
         throw core::InputError(spec_.source_file, "/outputs/series/quantities", q,
-                               "one of drag_coefficient, lift_coefficient, taylor_deformation, inclination, "
+                               "one of drag_coefficient, lift_coefficient, position, taylor_deformation, inclination, "
                                "area_change, tank_treading_phase, tank_treading_period, mass, kinetic_energy");
       }
     }
@@ -504,6 +578,11 @@ class Scene {
         for (const auto& b : bodies_) {
           const auto [cd, cl] = coefficients(b);
           row[k++] = q == "drag_coefficient" ? cd : cl;
+        }
+      } else if (q == "position") {
+        for (const auto& b : bodies_) {
+          for (int a = 0; a < D; ++a) row[k++] = b.kinematics ? b.pose.x[a] : b.shape.center[a];
+          if constexpr (D == 2) row[k++] = b.kinematics ? b.pose.angle : b.shape.angle;
         }
       } else if (is_capsule_quantity(q)) {
         for (std::size_t c = 0; c < capsules_.size(); ++c) row[k++] = capsule_value(c, q);
@@ -747,6 +826,7 @@ class Scene {
   LatticeUnits units_;
   FluidT fluid_;
   std::vector<RigidBody> bodies_;
+  long fine_steps_ = 0;  // finest-block steps done: the IB stage of step k works at t = k dt_fine
   std::vector<Capsule<D>> capsules_;
   // The union of the IB stencils of the current step (collect_forced_nodes) and, for capsules,
   // the forced velocity at those nodes; buffers only grow.

@@ -700,9 +700,9 @@ TEST(case_capsule, RejectsACapsuleReachingOutOfTheFineBlock) {
 }
 
 TEST(case_capsule, RejectsUnsupportedCombinations) {
-  json rigid_ellipse = cylinder_json();
-  rigid_ellipse["physics"]["bodies"][0]["shape"]["type"] = "ellipse";
-  expect_doc_rejected(rigid_ellipse, "/physics/bodies/0/shape/type", {"circle", "rigid body"});
+  json rigid_biconcave = cylinder_json();
+  rigid_biconcave["physics"]["bodies"][0]["shape"]["type"] = "biconcave";
+  expect_doc_rejected(rigid_biconcave, "/physics/bodies/0/shape/type", {"circle", "rigid body"});
   json sphere_capsule = capsule_json();
   sphere_capsule["physics"]["bodies"][0]["shape"]["type"] = "sphere";
   expect_doc_rejected(sphere_capsule, "/physics/bodies/0/shape/type", {"2D shape", "ellipse"});
@@ -719,6 +719,78 @@ TEST(case_capsule, RejectsUnsupportedCombinations) {
   three_d["fidelity"] = {{"standard", json::object()}};
   three_d.erase("acceptance");
   expect_doc_rejected(three_d, "/physics/bodies/0/membrane", {"3D membranes", "not implemented"});
+}
+
+// ---------------------------------------------------------------- moving rigid bodies
+
+/// The cylinder case with the cylinder moving along x from its centre (10, 10) by `x`, a formula
+/// of T: T is t until t = 20, then 20 (at rest, so the path is continuous).
+json moving_json(const std::string& x = "10 + 0.5*sin(omega*T)") {
+  auto at = [&](const std::string& time) {
+    std::string f = x;
+    for (std::size_t p = f.find('T'); p != std::string::npos; p = f.find('T', p + time.size()))
+      f.replace(p, 1, time);
+    return f;
+  };
+  json doc = cylinder_json();
+  doc["physics"]["bodies"][0]["motion"] = {
+      {"type", "prescribed"},
+      {"parameters", {{"omega", 0.5}}},
+      {"segments", json::array({{{"until", 20.0}, {"position", {at("t"), "10"}}},
+                                {{"position", {at("20"), "10"}}}})}};
+  return doc;
+}
+
+TEST(case_motion, PrescribedKinematicsAreExact) {
+  const CaseSpec spec = parse_case(moving_json(), "moving.json", "standard", {});
+  const auto& body = spec.physics.bodies.at(0);
+  ASSERT_TRUE(body.is_moving());
+  const auto pose = body.motion->kinematics->at(3.0);
+  EXPECT_NEAR(pose.x[0], 10 + 0.5 * std::sin(1.5), 1e-14);
+  EXPECT_NEAR(pose.v[0], 0.25 * std::cos(1.5), 1e-14);
+  EXPECT_NEAR(pose.a[0], -0.125 * std::sin(1.5), 1e-14);
+  EXPECT_EQ(pose.v[1], 0.0);
+  EXPECT_EQ(pose.angle, 0.0);  // no "angle": the shape's orientation, constant
+  const auto later = body.motion->kinematics->at(30.0);  // second segment: at rest
+  EXPECT_NEAR(later.x[0], 10 + 0.5 * std::sin(10.0), 1e-14);
+  EXPECT_EQ(later.v[0], 0.0);
+}
+
+TEST(case_motion, RejectsBadFormulasWithTheirPathAndPlace) {
+  expect_doc_rejected(moving_json("10 + 0.5*sin(omeg*T)"), "/physics/bodies/0/motion/segments/0/position/0",
+                      {"unknown name 'omeg'", "omega", "^"});
+  expect_doc_rejected(moving_json("10 + (T"), "/physics/bodies/0/motion/segments/0/position/0", {"expected ')'"});
+}
+
+TEST(case_motion, RejectsInconsistentSegments) {
+  json no_segments = moving_json();
+  no_segments["physics"]["bodies"][0]["motion"].erase("segments");
+  expect_doc_rejected(no_segments, "/physics/bodies/0/motion/segments", {"non-empty array", "prescribed"});
+  json open_end = moving_json();
+  open_end["physics"]["bodies"][0]["motion"]["segments"][1]["until"] = 40;
+  expect_doc_rejected(open_end, "/physics/bodies/0/motion/segments/1/until", {"last segment"});
+  json backwards = moving_json();
+  backwards["physics"]["bodies"][0]["motion"]["segments"].insert(
+      backwards["physics"]["bodies"][0]["motion"]["segments"].begin() + 1,
+      json{{"until", 10.0}, {"position", {"10 + 0.5*sin(omega*t)", "10"}}});
+  expect_doc_rejected(backwards, "/physics/bodies/0/motion/segments/1/until", {"after the previous segment"});
+  json fixed_with_segments = moving_json();
+  fixed_with_segments["physics"]["bodies"][0]["motion"]["type"] = "fixed";
+  expect_doc_rejected(fixed_with_segments, "/physics/bodies/0/motion/segments", {"prescribed"});
+}
+
+TEST(case_motion, RejectsAPathThatJumpsStartsElsewhereOrLeavesTheFineRegion) {
+  json jump = moving_json();
+  jump["physics"]["bodies"][0]["motion"]["segments"][1]["position"][0] = "11";
+  expect_doc_rejected(jump, "/physics/bodies/0/motion/segments/1", {"continuous at t = 20", "x position"});
+  expect_doc_rejected(moving_json("11 + 0.5*sin(omega*T)"), "/physics/bodies/0/motion/segments",
+                      {"starts at its shape.center", "shape.center has 10"});
+  // Amplitude 3: the cylinder (fine region [8, 16] x [8, 12]) leaves it on the left.
+  expect_doc_rejected(moving_json("10 - 3*sin(omega*T)"), "/physics/bodies/0/motion/segments",
+                      {"inside the fine region", "at t = "});
+  // sqrt of a negative number between t = 5 and 15.
+  expect_doc_rejected(moving_json("10 + 0*sqrt((T - 5)*(T - 15))"), "/physics/bodies/0/motion/segments",
+                      {"not finite at t = 5"});
 }
 
 }  // namespace
