@@ -581,8 +581,10 @@ class Scene {
         }
       } else if (q == "position") {
         for (const auto& b : bodies_) {
-          for (int a = 0; a < D; ++a) row[k++] = b.kinematics ? b.pose.x[a] : b.shape.center[a];
-          if constexpr (D == 2) row[k++] = b.kinematics ? b.pose.angle : b.shape.angle;
+          // At the row's time (b.pose is that of the last IB stage, one fine step earlier).
+          const auto pose = b.kinematics ? b.kinematics->at(t) : expr::RigidPose{};
+          for (int a = 0; a < D; ++a) row[k++] = b.kinematics ? pose.x[a] : b.shape.center[a];
+          if constexpr (D == 2) row[k++] = b.kinematics ? pose.angle : b.shape.angle;
         }
       } else if (is_capsule_quantity(q)) {
         for (std::size_t c = 0; c < capsules_.size(); ++c) row[k++] = capsule_value(c, q);
