@@ -1,6 +1,7 @@
 # caplab — top-level commands. See README.md.
 #   make reproduce            whole catalogue at fidelity "quick", then the report
 #   make reproduce-chapterN   one chapter (default fidelity "standard"; FIDELITY=thesis to change)
+#   make reproduce-extra      the external validations that are not thesis cases (catalogue/extra)
 #   make test                 unit + verification + short validation (what CI runs)
 #   make bench | stress | report | clean
 
@@ -12,7 +13,8 @@ CAPLAB := $(BUILD)/solver/app/caplab
 RESULTS ?= results
 
 .PHONY: all deps build test reproduce report bench stress clean \
-        reproduce-chapter2 reproduce-chapter3 reproduce-chapter4 reproduce-chapter5 reproduce-chapter6
+        reproduce-chapter2 reproduce-chapter3 reproduce-chapter4 reproduce-chapter5 reproduce-chapter6 \
+        reproduce-extra
 
 all: build
 
@@ -33,6 +35,9 @@ reproduce: build
 
 reproduce-chapter%: build
 	@scripts/reproduce --caplab $(CAPLAB) --fidelity $(or $(FIDELITY),standard) --results $(RESULTS) catalogue/ch$*
+
+reproduce-extra: build
+	@scripts/reproduce --caplab $(CAPLAB) --fidelity $(or $(FIDELITY),standard) --results $(RESULTS) catalogue/extra
 
 report:
 	@scripts/report --results $(RESULTS)

@@ -273,12 +273,16 @@ void check_outputs(const CaseSpec& spec, const CaseDiagnostics& diag) {
 
 void check_acceptance(const CaseSpec& spec, const std::vector<std::string>& levels,
                       const CaseDiagnostics& diag) {
-  std::set<std::string> metrics;
+  std::set<std::pair<std::string, std::string>> scored;
   for (std::size_t i = 0; i < spec.acceptance.size(); ++i) {
     const AcceptanceSpec& entry = spec.acceptance[i];
     const std::string at = fmt::format("/acceptance/{}", i);
-    if (!metrics.insert(entry.metric).second)
-      diag.fail(at + "/metric", json(entry.metric), "a metric not scored by another acceptance entry");
+    if (!scored.insert({entry.metric, entry.reference}).second)
+      diag.fail(at + "/metric", json(entry.metric),
+                "a metric not scored against the same reference by another acceptance entry");
+    if (!entry.window.empty() && !(entry.window[0] >= 0 && entry.window[1] <= spec.numerics.end_time * (1 + 1e-12)))
+      diag.fail(at + "/window", json(entry.window),
+                fmt::format("a window inside the run [0, end_time] = [0, {}]", spec.numerics.end_time));
     if (entry.comparison == "mode") continue;  // an exact match: no tolerance per level
     for (const auto& [level, tolerance] : entry.tolerance)
       if (std::find(levels.begin(), levels.end(), level) == levels.end())

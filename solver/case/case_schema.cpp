@@ -76,9 +76,13 @@ constexpr Range closed(double lo, double hi) { return {lo, hi, false, false}; }
 /// The comparison of an acceptance entry whose reference is a flow regime, not a number.
 constexpr std::string_view mode_comparison = "mode";
 
-/// Allowed `acceptance[].comparison`: the numeric ones (case_enums.hpp) and "mode".
+/// The comparison of a series column against a reference history (score/comparators.hpp).
+constexpr std::string_view series_comparison = "time_series";
+
+/// Allowed `acceptance[].comparison`: the numeric ones (case_enums.hpp), "time_series" and "mode".
 std::vector<std::string> acceptance_comparisons() {
   std::vector<std::string> names{comparison_names.begin(), comparison_names.end()};
+  names.emplace_back(series_comparison);
   names.emplace_back(mode_comparison);
   return names;
 }
@@ -153,6 +157,7 @@ SchemaNode build_case_schema() {
       opt("reference_mode", any()),
       req("comparison", choice(acceptance_comparisons())),
       opt("tolerance", map_of(number(positive))),
+      opt("window", array_of(number())),  // time_series only: [from, to] in L/U
       req("justification", text()),
   });
   return object({
@@ -247,10 +252,13 @@ void check_acceptance_entries(const json& doc, const CaseDiagnostics& diag) {
     const std::string at = child_pointer("/acceptance", i);
     const std::string& comparison = entry.at("comparison").get_ref<const std::string&>();
     const bool mode = comparison == mode_comparison;
+    const bool series = comparison == series_comparison;
     const std::string when = at + "/comparison is \"" + comparison + "\"";
     using Keys = std::vector<std::string>;
-    const Keys needed = mode ? Keys{"reference_mode"} : Keys{"reference_value", "tolerance"};
-    const Keys unused = mode ? Keys{"reference_value", "tolerance"} : Keys{"reference_mode"};
+    const Keys needed = mode ? Keys{"reference_mode"} : series ? Keys{"tolerance"} : Keys{"reference_value", "tolerance"};
+    const Keys unused = mode     ? Keys{"reference_value", "tolerance", "window"}
+                        : series ? Keys{"reference_value", "reference_mode"}
+                                 : Keys{"reference_mode", "window"};
     for (const auto& key : needed)
       if (!entry.contains(key))
         diag.fail_text(child_pointer(at, key), "nothing (required key \"" + key + "\" is missing)",
@@ -260,8 +268,14 @@ void check_acceptance_entries(const json& doc, const CaseDiagnostics& diag) {
       if (entry.contains(key))
         diag.fail(child_pointer(at, key), entry.at(key),
                   "no \"" + key + "\" key when " + when +
-                      (mode ? ": a mode is matched exactly against \"reference_mode\"; remove it"
-                            : ": \"reference_mode\" belongs to the comparison \"mode\"; remove it"));
+                      (mode     ? ": a mode is matched exactly against \"reference_mode\"; remove it"
+                       : series ? ": the reference history is the file named by \"reference\"; remove it"
+                                : ": it belongs to the comparison \"mode\" or \"time_series\"; remove it"));
+    if (series && entry.contains("window")) {
+      const json& w = entry.at("window");
+      if (w.size() != 2 || !(w[0].get<double>() < w[1].get<double>()))
+        diag.fail(child_pointer(at, "window"), w, "[from, to] with from < to, in L/U");
+    }
     if (!mode) continue;
     const std::string pointer = child_pointer(at, "reference_mode");
     const json& reference = entry.at("reference_mode");

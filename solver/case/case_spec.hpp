@@ -149,9 +149,10 @@ struct AcceptanceSpec {
   std::string metric;         ///< a key of summary.json
   std::string reference;      ///< path of a references/ dataset (with #key) or "value"
   double reference_value = 0.0;
-  std::string comparison;     ///< "relative" | "absolute" | "mode"
+  std::string comparison;     ///< "relative" | "absolute" | "time_series" | "mode"
   std::map<std::string, double> tolerance;  ///< per fidelity level (numeric comparisons)
   std::vector<std::string> reference_modes;   ///< comparison "mode": the allowed modes
+  std::vector<double> window;                 ///< comparison "time_series": [from, to] in L/U, or empty
   std::string justification;
 };
 

@@ -252,8 +252,9 @@ CaseSpec to_spec(const json& doc, const CaseDiagnostics& diag) {
       const json& m = a.at("reference_mode");
       entry.reference_modes = m.is_array() ? m.get<std::vector<std::string>>() : std::vector<std::string>{m};
     } else {
-      entry.reference_value = a.at("reference_value").get<double>();
+      entry.reference_value = a.value("reference_value", 0.0);  // time_series: the reference file
       entry.tolerance = a.at("tolerance").get<std::map<std::string, double>>();
+      entry.window = a.value("window", std::vector<double>{});
     }
     entry.justification = a.at("justification").get<std::string>();
     spec.acceptance.push_back(std::move(entry));

@@ -485,7 +485,7 @@ TEST(case_rejects, NumericEntryNeedsValueAndToleranceAndNoReferenceMode) {
   expect_doc_rejected(doc, "/acceptance/0/reference_mode",
                       {"no \"reference_mode\" key", "belongs to the comparison \"mode\""});
   expect_set_rejected({"acceptance.0.comparison=modes"}, "/acceptance/0/comparison",
-                      {"\"relative\", \"absolute\", \"mode\"", "did you mean \"mode\"?"});
+                      {"\"relative\", \"absolute\", \"time_series\", \"mode\"", "did you mean \"mode\"?"});
 }
 
 TEST(case_rejects, DuplicateBodyNames) {
@@ -791,6 +791,38 @@ TEST(case_motion, RejectsAPathThatJumpsStartsElsewhereOrLeavesTheFineRegion) {
   // sqrt of a negative number between t = 5 and 15.
   expect_doc_rejected(moving_json("10 + 0*sqrt((T - 5)*(T - 15))"), "/physics/bodies/0/motion/segments",
                       {"not finite at t = 5"});
+}
+
+TEST(case_acceptance, TimeSeriesEntriesTakeAWindowAndNoReferenceValue) {
+  json doc = cylinder_json();
+  json entry = {{"metric", "drag_coefficient"},
+                {"reference", "references/cylinder/some_history.csv#t:cd"},
+                {"comparison", "time_series"},
+                {"window", {150, 250}},
+                {"tolerance", {{"quick", 0.1}, {"standard", 0.1}, {"thesis", 0.1}}},
+                {"justification", "test"}};
+  doc["acceptance"] = json::array({entry});
+  const CaseSpec spec = parse_case(doc, "series.json", "standard", {});
+  ASSERT_EQ(spec.acceptance.size(), 1U);
+  EXPECT_EQ(spec.acceptance[0].window, (std::vector<double>{150, 250}));
+  json with_value = doc;
+  with_value["acceptance"][0]["reference_value"] = 1.4;
+  expect_doc_rejected(with_value, "/acceptance/0/reference_value", {"the reference history"});
+  json backwards = doc;
+  backwards["acceptance"][0]["window"] = {250, 150};
+  expect_doc_rejected(backwards, "/acceptance/0/window", {"from < to"});
+  json beyond = doc;
+  beyond["acceptance"][0]["window"] = {150, 300};
+  expect_doc_rejected(beyond, "/acceptance/0/window", {"inside the run"});
+  json numeric_window = cylinder_json();
+  numeric_window["acceptance"][0]["window"] = {150, 250};
+  expect_doc_rejected(numeric_window, "/acceptance/0/window", {"remove it"});
+  // The same metric may be scored against two references, not twice against one.
+  json twice = doc;
+  twice["acceptance"].push_back(entry);
+  expect_doc_rejected(twice, "/acceptance/1/metric", {"same reference"});
+  twice["acceptance"][1]["reference"] = "references/cylinder/other_history.csv#t:cd";
+  EXPECT_NO_THROW(parse_case(twice, "series.json", "standard", {}));
 }
 
 }  // namespace
