@@ -3,7 +3,8 @@
 Output (``out``):
     index.html, index.pdf            every chapter's verdicts, environment
     chapterN/index.html, index.pdf   one chapter: cases, figures, scorecards, tables 2.1/2.2 (ch2),
-                                     capsule families, thesis statements, verification (capsule.py)
+                                     capsule families, thesis statements, verification (capsule.py),
+                                     moving bodies: statements, twins, validation (moving.py)
     references.html                  provenance of every reference dataset, with anchors
 
 Files are written to a temporary name and renamed, under an exclusive lock on ``out/.lock``, so
@@ -24,7 +25,7 @@ from pathlib import Path
 
 import jinja2
 
-from . import capsule, cylinder, figures
+from . import capsule, cylinder, figures, moving
 from .references import KIND_LABELS, ReferenceLibrary, claim_summary, parameters_text
 from .runs import (Run, catalogue_cases, chapter_slug, chapter_sort_key, chapter_title, discover,
                    finite, with_missing)
@@ -325,10 +326,14 @@ def build_report(results: Path, out: Path, references: Path | None = None, catal
                     if ds is not None:
                         used[ds.anchor] = ds
             tables = cylinder.build(chapter_runs, refs) if chapter == "ch2" else None
-            capsules = capsule.build(chapter_runs, refs, chapter)
+            capsules = capsule.build(chapter_runs, moving.without_statements(refs), chapter)
             for ds in capsules.datasets:
                 used[ds.anchor] = ds
             result.problems += [f"{chapter}: {p}" for p in capsules.problems]
+            motions = moving.build(chapter_runs, refs, chapter)
+            for ds in motions.datasets:
+                used[ds.anchor] = ds
+            result.problems += [f"{chapter}: {p}" for p in motions.problems]
             conventions = {}
             if tables is not None:
                 for name in ("table_2_1.csv", "table_2_2.csv", "cylinder_extra_reference_values.csv"):
@@ -345,7 +350,7 @@ def build_report(results: Path, out: Path, references: Path | None = None, catal
             html = env.get_template("chapter.html.j2").render(
                 title=f"caplab report — {chapter_title(chapter)}", chapter=chapter,
                 chapter_title=chapter_title(chapter), runs=chapter_runs, views=views, counts=counts(chapter_runs),
-                tables=tables, capsules=capsules, datasets=sorted(used.values(), key=lambda d: d.rel),
+                tables=tables, capsules=capsules, moving=motions, datasets=sorted(used.values(), key=lambda d: d.rel),
                 conventions=conventions,
                 builds=builds,
                 env_rows=env_rows, meta=meta, cost_figure=figures.cost_vs_error(chapter_runs),
