@@ -23,6 +23,12 @@ struct ScoreArgs {
   std::filesystem::path run_dir;
   bool strict = false;
 };
+struct ClaimsArgs {
+  std::filesystem::path claims_file, json_out;
+  std::vector<std::filesystem::path> run_dirs;
+  std::string only;
+  bool strict = false;
+};
 struct BenchArgs {
   std::filesystem::path out;
   bool quick = false;
@@ -32,6 +38,7 @@ int run(const RunArgs& args, bool terminal);
 int check(const CheckArgs& args);
 int list(const std::filesystem::path& dir);
 int score(const ScoreArgs& args);
+int claims(const ClaimsArgs& args);
 int bench(const BenchArgs& args);
 
 }  // namespace caplab::app

@@ -1,4 +1,4 @@
-// The `caplab` command: run, check, list, score, bench.
+// The `caplab` command: run, check, list, score, claims, bench.
 //
 // The only place that maps errors to exit codes (DESIGN.md section 6): 0 ran (and, with
 // --strict, passed), 1 scored outside tolerance, 2 bad input, 3 numerical instability,
@@ -50,6 +50,20 @@ int main(int argc, char** argv) {
   score_cmd->add_option("run_dir", score.run_dir, "Run directory")->required()->check(CLI::ExistingDirectory);
   score_cmd->add_flag("--strict", score.strict, "Exit 1 when sanity or accuracy fails");
 
+  app::ClaimsArgs claims;
+  auto* claims_cmd = app.add_subcommand(
+      "claims",
+      "Check thesis statements (claims.json: trends, brackets, modes, bounds) against several runs");
+  claims_cmd->add_option("claims", claims.claims_file, "Claims file, e.g. references/capsule2d/claims.json")
+      ->required()
+      ->check(CLI::ExistingFile);
+  claims_cmd->add_option("run_dirs", claims.run_dirs, "Run directories (non-capsule runs are ignored)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  claims_cmd->add_option("--json", claims.json_out, "Also write the verdicts as JSON to this file");
+  claims_cmd->add_option("--only", claims.only, "Only the claims whose id starts with this, e.g. ch3.");
+  claims_cmd->add_flag("--strict", claims.strict, "Exit 1 when a claim is inconsistent with the runs");
+
   app::BenchArgs bench;
   auto* bench_cmd = app.add_subcommand("bench", "Measure memory bandwidth and fluid MLUPS (roofline)");
   bench_cmd->add_option("--out", bench.out, "Output directory")->default_val("reports/out/bench");
@@ -61,6 +75,7 @@ int main(int argc, char** argv) {
     if (*check_cmd) return app::check(check);
     if (*list_cmd) return app::list(list_dir);
     if (*score_cmd) return app::score(score);
+    if (*claims_cmd) return app::claims(claims);
     if (*bench_cmd) return app::bench(bench);
   } catch (const core::InputError& e) {
     fmt::print(stderr, "caplab: input error: {}\n", e.what());

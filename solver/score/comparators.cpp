@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 #include "core/error.hpp"
 
@@ -56,6 +57,51 @@ double interpolate(const Series& s, double t) {
   const auto i = static_cast<std::size_t>(upper - s.t.begin());
   const double w = (t - s.t[i - 1]) / (s.t[i] - s.t[i - 1]);
   return (1.0 - w) * s.y[i - 1] + w * s.y[i];
+}
+
+/// "\"a\" or \"b\"": the modes of a list as they appear in messages.
+std::string quoted_list(const std::vector<std::string>& modes) {
+  std::string listed;
+  for (const auto& mode : modes) listed += (listed.empty() ? "\"" : " or \"") + mode + "\"";
+  return listed;
+}
+
+/// Why a list of allowed modes cannot be used (empty when it can); `what` names the list.
+std::string bad_modes(const std::vector<std::string>& modes, const std::string& what) {
+  if (modes.empty()) return "no " + what + " mode given";
+  if (std::find(modes.begin(), modes.end(), "") != modes.end())
+    return "a " + what + " mode is an empty string";
+  return "";
+}
+
+std::string join(const std::vector<std::string>& parts, const char* separator) {
+  std::string out;
+  for (const auto& p : parts) out += (out.empty() ? "" : separator) + p;
+  return out;
+}
+
+/// How point `i` of a sweep is named in messages: its label, or its position.
+std::string point_name(const std::vector<std::string>& labels, std::size_t i) {
+  return labels.empty() ? fmt::format("point {}", i + 1) : labels[i];
+}
+
+std::optional<Comparison> reject_labels(const std::vector<std::string>& labels, std::size_t points) {
+  if (labels.empty() || labels.size() == points) return std::nullopt;
+  return Comparison{kNaN, false, fmt::format("{} labels given for {} points", labels.size(), points)};
+}
+
+const char* direction_name(Direction d) {
+  switch (d) {
+    case Direction::increasing:
+      return "increasing";
+    case Direction::decreasing:
+      return "decreasing";
+    case Direction::non_decreasing:
+      return "non-decreasing";
+    case Direction::non_increasing:
+      return "non-increasing";
+  }
+  return "?";
 }
 
 }  // namespace
@@ -132,15 +178,114 @@ Comparison compare_time_series(const Series& run, const Series& reference, doubl
 }
 
 Comparison compare_mode(std::string_view value, const std::vector<std::string>& allowed) {
-  if (allowed.empty()) return {kNaN, false, "no reference mode given"};
-  std::string listed;
-  for (const auto& mode : allowed) {
-    if (mode.empty()) return {kNaN, false, "a reference mode is an empty string"};
-    listed += (listed.empty() ? "\"" : " or \"") + mode + "\"";
-  }
+  if (const std::string bad = bad_modes(allowed, "reference"); !bad.empty()) return {kNaN, false, bad};
+  const std::string listed = quoted_list(allowed);
   if (value.empty()) return {kNaN, false, "the mode is an empty string; expected " + listed};
   if (std::find(allowed.begin(), allowed.end(), value) != allowed.end()) return {0.0, true, ""};
   return {1.0, false, fmt::format("mode \"{}\" is not the reference {}", value, listed)};
+}
+
+Comparison compare_trend(std::vector<std::pair<double, double>> points, Direction direction, double tolerance,
+                         const std::vector<std::string>& labels, PointVerdicts* verdicts) {
+  if (verdicts) verdicts->clear();
+  if (!std::isfinite(tolerance) || tolerance < 0)
+    return {kNaN, false, fmt::format("tolerance must be finite and >= 0 (got {})", tolerance)};
+  if (auto bad = reject_labels(labels, points.size())) return *bad;
+  const std::size_t n = points.size();
+  for (std::size_t i = 0; i < n; ++i)
+    if (!std::isfinite(points[i].first) || !std::isfinite(points[i].second))
+      return {kNaN, false,
+              fmt::format("{} is not finite (parameter {}, value {})", point_name(labels, i), points[i].first,
+                          points[i].second)};
+
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return points[a].first < points[b].first; });
+  const bool up = direction == Direction::increasing || direction == Direction::non_decreasing;
+  const bool strict = direction == Direction::increasing || direction == Direction::decreasing;
+  const double sign = up ? 1.0 : -1.0;
+  auto describe = [&](std::size_t i) {
+    return fmt::format("{:.6g} at {:.6g} ({})", points[i].second, points[i].first, point_name(labels, i));
+  };
+
+  PointVerdicts judged(n);
+  double error = -std::numeric_limits<double>::infinity();
+  std::size_t steps = 0, levels = 0;
+  std::vector<std::string> against;
+  // [lower, begin): the points at the previous distinct parameter value; [begin, end): this one.
+  for (std::size_t lower = 0, begin = 0; begin < n; ++levels) {
+    std::size_t end = begin;
+    while (end < n && points[order[end]].first == points[order[begin]].first) ++end;
+    for (std::size_t a = begin; levels > 0 && a < end; ++a) {
+      bool ok = true;
+      for (std::size_t b = lower; b < begin; ++b) {
+        const std::size_t i = order[a], j = order[b];
+        const double step = sign * (points[j].second - points[i].second);  // > 0: against the direction
+        error = std::max(error, step);
+        ++steps;
+        if (strict ? step < tolerance : step <= tolerance) continue;
+        ok = false;
+        against.push_back(describe(j) + " -> " + describe(i));
+      }
+      judged[order[a]] = ok;
+    }
+    lower = begin;
+    begin = end;
+  }
+  if (verdicts) *verdicts = judged;
+  if (steps == 0)
+    return {kNaN, false,
+            fmt::format("{} point(s) at {} distinct parameter value(s): a trend needs two values", n, levels),
+            false};
+  if (against.empty()) return {error, true, ""};
+  return {error, false,
+          fmt::format("not {}{}: {} of {} steps go against it: {}", direction_name(direction),
+                      tolerance > 0 ? fmt::format(" within {:.4g}", tolerance) : "", against.size(), steps,
+                      join(against, "; "))};
+}
+
+Comparison compare_mode_bracket(std::vector<std::pair<double, std::string>> points, double lo, double hi,
+                                const std::vector<std::string>& below, const std::vector<std::string>& above,
+                                const std::vector<std::string>& labels, PointVerdicts* verdicts) {
+  if (verdicts) verdicts->clear();
+  if (!std::isfinite(lo) || !std::isfinite(hi) || lo > hi)
+    return {kNaN, false, fmt::format("bracket [{}, {}] is not a finite interval with lo <= hi", lo, hi)};
+  for (const auto& [modes, what] : {std::pair{&below, "below"}, std::pair{&above, "above"}})
+    if (const std::string bad = bad_modes(*modes, what); !bad.empty()) return {kNaN, false, bad};
+  if (auto bad = reject_labels(labels, points.size())) return *bad;
+
+  PointVerdicts judged(points.size());
+  std::size_t n_below = 0, n_above = 0;
+  std::vector<std::string> wrong;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto& [x, mode] = points[i];
+    if (!std::isfinite(x))
+      return {kNaN, false, fmt::format("the parameter of {} is not finite ({})", point_name(labels, i), x)};
+    const bool is_below = x <= lo;
+    if (!is_below && x < hi) continue;  // inside the bracket: either regime
+    const std::vector<std::string>& expected = is_below ? below : above;
+    ++(is_below ? n_below : n_above);
+    judged[i] = std::find(expected.begin(), expected.end(), mode) != expected.end();
+    if (!*judged[i])
+      wrong.push_back(fmt::format("{} at {:.6g} ({} the bracket) is {}, expected {}", point_name(labels, i),
+                                  x, is_below ? "below" : "above",
+                                  mode.empty() ? "without a mode" : "\"" + mode + "\"",
+                                  quoted_list(expected)));
+  }
+  if (verdicts) *verdicts = judged;
+  if (!wrong.empty())
+    return {static_cast<double>(wrong.size()), false,
+            fmt::format("{} of {} points on the wrong side of [{:.6g}, {:.6g}]: {}", wrong.size(),
+                        n_below + n_above, lo, hi, join(wrong, "; "))};
+  if (n_below == 0 || n_above == 0)
+    return {kNaN, false,
+            fmt::format(
+                "{} point(s) at or below {:.6g} and {} at or above {:.6g}: the transition needs a point on "
+                "each side",
+                n_below, lo, n_above, hi),
+            false};
+  return {0.0, true, ""};
 }
 
 }  // namespace caplab::score

@@ -1,6 +1,6 @@
-// Unit tests of the score comparators (relative, absolute, bracket, time_series, mode) and of the
-// reference CSV reader. Every comparator is shown to accept what it should and to reject what
-// it must (DESIGN.md section 7: every check must be able to fail).
+// Unit tests of the score comparators (relative, absolute, bracket, time_series, mode, and the
+// sweep comparators trend and mode_bracket) and of the reference CSV reader. Every comparator is shown to
+// accept what it should and to reject what it must (DESIGN.md section 7: every check must be able to fail).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -9,7 +9,10 @@
 #include <fstream>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/error.hpp"
 #include "score/comparators.hpp"
@@ -255,6 +258,149 @@ TEST_F(ScoreReferenceCsv, MustReject) {
   EXPECT_THROW(read_reference_series(dir_ / "absent.csv"), core::InputError);
   EXPECT_THROW(resolve_reference_file("references/none.csv", dir_, dir_), core::InputError);
   EXPECT_EQ(resolve_reference_file("ref.csv", dir_ / "runs" / "r1", ""), dir_ / "ref.csv");  // found upward
+}
+
+// ---- sweep comparators ---------------------------------------------------------------------------
+
+using Points = std::vector<std::pair<double, double>>;
+using Modes = std::vector<std::pair<double, std::string>>;
+const std::vector<std::string> kTT{"steady_tank_treading", "oscillating_tank_treading"};
+
+TEST(ScoreTrend, MonotoneIncreasingPassesInAnyInputOrder) {
+  PointVerdicts v;
+  const Comparison c =
+      compare_trend(Points{{0.04, 0.3}, {0.01, 0.1}, {0.02, 0.2}}, Direction::increasing, 0.0, {}, &v);
+  EXPECT_TRUE(c.pass);
+  EXPECT_TRUE(c.decided);
+  EXPECT_TRUE(c.message.empty());
+  EXPECT_NEAR(c.error, -0.1, 1e-15);  // the smallest rise, as a negative step against the direction
+  ASSERT_EQ(v.size(), 3u);
+  EXPECT_FALSE(v[1].has_value());  // the lowest parameter value is not judged
+  EXPECT_EQ(v[0], true);
+  EXPECT_EQ(v[2], true);
+}
+
+TEST(ScoreTrend, SingleReversalFailsNamingBothRuns) {
+  PointVerdicts v;
+  const Comparison c = compare_trend(Points{{1, 0.1}, {2, 0.2}, {3, 0.15}, {4, 0.3}}, Direction::increasing,
+                                     0.0, {"ch2/G1", "ch2/G2", "ch2/G3", "ch2/G4"}, &v);
+  EXPECT_FALSE(c.pass);
+  EXPECT_TRUE(c.decided);
+  EXPECT_NEAR(c.error, 0.05, 1e-15);
+  EXPECT_EQ(c.message, "not increasing: 1 of 3 steps go against it: 0.2 at 2 (ch2/G2) -> 0.15 at 3 (ch2/G3)");
+  EXPECT_EQ(v, (PointVerdicts{std::nullopt, true, false, true}));
+  EXPECT_TRUE(compare_trend(Points{{1, 0.1}, {2, 0.2}, {3, 0.15}}, Direction::increasing, 0.06).pass);
+  EXPECT_NE(compare_trend(Points{{1, 0.2}, {2, 0.1}}, Direction::increasing).message.find("point 1"),
+            std::string::npos);  // without labels, points are named by position
+}
+
+TEST(ScoreTrend, DecreasingDirection) {
+  EXPECT_TRUE(compare_trend(Points{{0, 3.0}, {1, 2.0}, {2, 1.0}}, Direction::decreasing).pass);
+  const Comparison c = compare_trend(Points{{0, 3.0}, {1, 2.0}, {2, 2.5}}, Direction::decreasing);
+  EXPECT_FALSE(c.pass);
+  EXPECT_NEAR(c.error, 0.5, 1e-15);
+  EXPECT_NE(c.message.find("not decreasing"), std::string::npos);
+  EXPECT_FALSE(compare_trend(Points{{0, 1.0}, {1, 2.0}}, Direction::decreasing).pass);
+}
+
+TEST(ScoreTrend, Ties) {
+  // An equal value fails a strict direction at tolerance 0, passes a non-strict one.
+  const Comparison flat = compare_trend(Points{{0, 1.0}, {1, 1.0}}, Direction::increasing);
+  EXPECT_FALSE(flat.pass);
+  EXPECT_EQ(flat.error, 0.0);
+  EXPECT_TRUE(compare_trend(Points{{0, 1.0}, {1, 1.0}}, Direction::increasing, 1e-9).pass);
+  EXPECT_TRUE(compare_trend(Points{{0, 1.0}, {1, 1.0}, {2, 2.0}}, Direction::non_decreasing).pass);
+  EXPECT_TRUE(compare_trend(Points{{0, 2.0}, {1, 2.0}, {2, 0.0}}, Direction::non_increasing).pass);
+  EXPECT_FALSE(compare_trend(Points{{0, 0.0}, {1, 1.0}, {2, 0.0}}, Direction::non_decreasing).pass);
+  // Runs at the same parameter value are not compared with each other, only with the next value.
+  PointVerdicts v;
+  EXPECT_TRUE(
+      compare_trend(Points{{1, 0.5}, {1, 0.2}, {2, 0.6}, {2, 0.7}}, Direction::increasing, 0, {}, &v).pass);
+  EXPECT_EQ(v, (PointVerdicts{std::nullopt, std::nullopt, true, true}));
+  const Comparison c =
+      compare_trend(Points{{1, 0.5}, {1, 0.7}, {2, 0.6}}, Direction::increasing, 0, {"a", "b", "c"});
+  EXPECT_FALSE(c.pass);
+  EXPECT_EQ(c.message, "not increasing: 1 of 2 steps go against it: 0.7 at 1 (b) -> 0.6 at 2 (c)");
+}
+
+TEST(ScoreTrend, TooFewPointsIsUndecided) {
+  for (const Points& p : {Points{}, Points{{0.04, 0.3}}, Points{{0.04, 0.3}, {0.04, 0.2}}}) {
+    const Comparison c = compare_trend(p, Direction::increasing);
+    EXPECT_FALSE(c.decided);
+    EXPECT_FALSE(c.pass);
+    EXPECT_TRUE(std::isnan(c.error));
+    EXPECT_NE(c.message.find("needs two values"), std::string::npos) << c.message;
+  }
+}
+
+TEST(ScoreTrend, MustFail) {
+  for (const Comparison& c :
+       {compare_trend(Points{{0, 1.0}, {1, kNaN}}, Direction::increasing),
+        compare_trend(Points{{kInf, 1.0}, {1, 2.0}}, Direction::increasing),
+        compare_trend(Points{{0, 1.0}, {1, 2.0}}, Direction::increasing, -1.0),
+        compare_trend(Points{{0, 1.0}, {1, 2.0}}, Direction::increasing, kNaN),
+        compare_trend(Points{{0, 1.0}, {1, 2.0}}, Direction::increasing, 0.0, {"only one label"})}) {
+    EXPECT_FALSE(c.pass);
+    EXPECT_TRUE(c.decided);
+    EXPECT_FALSE(c.message.empty());
+  }
+}
+
+TEST(ScoreModeBracket, PassesWithTheRegimesOnEachSide) {
+  PointVerdicts v;
+  const Comparison c = compare_mode_bracket(Modes{{0.0, "steady_tank_treading"},
+                                                  {0.04, "oscillating_tank_treading"},
+                                                  {0.05, "steady_tank_treading"},  // inside: either
+                                                  {0.06, "tumbling"},
+                                                  {0.4, "tumbling"}},
+                                            0.04, 0.06, kTT, {"tumbling"}, {}, &v);
+  EXPECT_TRUE(c.pass);
+  EXPECT_TRUE(c.decided);
+  EXPECT_EQ(c.error, 0.0);
+  EXPECT_EQ(v, (PointVerdicts{true, true, std::nullopt, true, true}));
+}
+
+TEST(ScoreModeBracket, ModeOnTheWrongSideFails) {
+  PointVerdicts v;
+  const Comparison c = compare_mode_bracket(
+      Modes{{0.04, "oscillating_tank_treading"}, {0.06, "oscillating_tank_treading"}}, 0.04, 0.06,
+      {"oscillating_tank_treading"}, {"tumbling"}, {"ch3/Eb0.04", "ch3/Eb0.06"}, &v);
+  EXPECT_FALSE(c.pass);
+  EXPECT_TRUE(c.decided);
+  EXPECT_EQ(c.error, 1.0);
+  EXPECT_EQ(c.message,
+            "1 of 2 points on the wrong side of [0.04, 0.06]: ch3/Eb0.06 at 0.06 (above the bracket) is "
+            "\"oscillating_tank_treading\", expected \"tumbling\"");
+  EXPECT_EQ(v, (PointVerdicts{true, false}));
+  // A point without a mode on a side is wrong; a wrong point decides even a one-sided sweep.
+  const Comparison none = compare_mode_bracket(Modes{{0.0, ""}}, 0.04, 0.06, kTT, {"tumbling"});
+  EXPECT_FALSE(none.pass);
+  EXPECT_TRUE(none.decided);
+  EXPECT_NE(none.message.find("without a mode"), std::string::npos);
+}
+
+TEST(ScoreModeBracket, NoRunOnOneSideIsUndecided) {
+  for (const Modes& m : {Modes{{0.01, "oscillating_tank_treading"}, {0.02, "steady_tank_treading"}},
+                         Modes{{0.1, "tumbling"}}, Modes{{0.05, "tumbling"}}, Modes{}}) {
+    const Comparison c = compare_mode_bracket(m, 0.04, 0.06, kTT, {"tumbling"});
+    EXPECT_FALSE(c.decided);
+    EXPECT_FALSE(c.pass);
+    EXPECT_NE(c.message.find("a point on each side"), std::string::npos) << c.message;
+  }
+}
+
+TEST(ScoreModeBracket, MustFail) {
+  const Modes m{{0.0, "steady_tank_treading"}, {1.0, "tumbling"}};
+  for (const Comparison& c : {compare_mode_bracket(m, 0.06, 0.04, kTT, {"tumbling"}),
+                              compare_mode_bracket(m, kNaN, 0.06, kTT, {"tumbling"}),
+                              compare_mode_bracket(m, 0.04, 0.06, {}, {"tumbling"}),
+                              compare_mode_bracket(m, 0.04, 0.06, kTT, {"tumbling", ""}),
+                              compare_mode_bracket(Modes{{kNaN, "tumbling"}}, 0.04, 0.06, kTT, {"tumbling"}),
+                              compare_mode_bracket(m, 0.04, 0.06, kTT, {"tumbling"}, {"one label"})}) {
+    EXPECT_FALSE(c.pass);
+    EXPECT_TRUE(c.decided);
+    EXPECT_FALSE(c.message.empty());
+  }
 }
 
 }  // namespace

@@ -1,0 +1,102 @@
+// Cross-run check of thesis statements (references/*/claims.json, format in
+// references/capsule2d/provenance.json): do the capsule runs together agree with "D grows with
+// G", "tumbling above E_b = 0.06", ...? score.json stays the per-run verdict; this is the
+// verdict of a set of runs on one statement. Used by `caplab claims` and the reports.
+//
+// Runs. A run directory is read for case.json, summary.json, manifest.json ("status",
+// "fidelity", "case_id") and, when a claim needs it, score.json and series.h5. Only capsule
+// runs are considered: a body with a "membrane" object, or a summary metric
+// taylor_deformation_final. Its fidelity is the manifest's (else case.json "fidelity_applied",
+// summary.json "fidelity", the name of the parent directory, results/<fidelity>/<case>); a
+// directory without manifest.json is "incomplete". A run's parameters in the keys of the claims are read from its
+// first membrane body, with the case-file defaults where a key is absent:
+//   shape (shape.type), capillary, bending_ratio (0), reference_curvature ("initial"; a circle
+//   with "circle" counts as "initial"), reynolds (physics.reynolds), angle (0),
+//   aspect_ratio (2, ellipses only), alpha (1.39, biconcave shapes only).
+//
+// Which runs a claim is about. Every key of the claim's "parameters" among shape,
+// aspect_ratio, alpha, reference_curvature, capillary, bending_ratio, reynolds must match
+// (other keys are ignored; reference_curvature is ignored for a run with bending_ratio 0): a
+// number within rel 1e-6 / abs 1e-12, a string exactly, {"from", "to"} inclusive (±1e-12),
+// an array as any of its elements. A key the claim does not give is free (the parameter a
+// trend varies). A run whose acceptance names the claim ("...json#<id>") is used even when it
+// does not match, and that mismatch alone makes the claim "inconsistent". Runs whose status is
+// not "ok" are listed and never judged.
+//
+// Kinds (each run's value is a summary.json metric; for a "statistic" of "max"/"min" the
+// extreme of the series.h5 column named by "metric", one of taylor_deformation, inclination,
+// area_change, tank_treading_phase, also as "<body>.<name>"):
+//   mode     each run's summary "mode" is one of the claim's "modes" (or "mode");
+//   bracket  compare_mode_bracket over ("varying" value, mode) with "between": [lo, hi],
+//            "below" and "above" read as regimes: a tank-treading side (steady_ or
+//            oscillating_tank_treading) accepts either tank-treading mode, any other side
+//            accepts "tumbling";
+//   trend    compare_trend, tolerance 0, in each series of runs that share every parameter
+//            above except "varying", the fidelity and numerics.grid.fine_spacing.
+//            "direction": increasing / decreasing (strict; for "metric": "mode", the regimes
+//            ordered steady_tank_treading < oscillating_tank_treading < tumbling, non-strict),
+//            "sequence" (non-decreasing), "approaches" with a numeric "limit" (|v − limit|
+//            decreasing). Consistent when no decided series fails and one passes;
+//   bound    "lower" / "upper" (exclusive when "strict"), each run; "quantifier": "some"
+//            needs one run inside, the others are listed unjudged; a bound without a number
+//            is not checked;
+//   value    the runs' metric is listed, never judged.
+// A trend or bound without "metric", a trend with several "varying" parameters or another
+// "direction", and every value claim are "not checked".
+//
+// Verdict of a claim, in this order: "not checked" for a value claim or a trend or bound
+// without "metric"; "inconsistent" when a named run is not about the claim or the check fails
+// (a decided comparison, a judged run); "consistent"; "not checked" for the other claims that
+// cannot be checked (above); "no run" when no run of the claim finished "ok"; "not enough
+// runs" for a trend or bracket that is undecided (no series with two parameter values, no run
+// on one side of the bracket); else "not checked" (runs, but nothing to judge, e.g. no
+// metric). Only "consistent" and "inconsistent" are decided.
+//
+// Layout of the result:
+//   {"claims_file": path | null,
+//    "runs": [{"run", "fidelity", "directory", "status", "parameters": {...}}],  // capsule runs
+//    "ignored": [{"directory", "reason"}], "problems": [...],   // claims without id, duplicates
+//    "claims": [{"id", "kind", "verdict", "message", "varying", "metric", "direction",
+//                "problems": [...],
+//                "runs": [{"run", "fidelity", "directory", "status", "parameter", "value",
+//                          "verdict": pass | fail | null, "note"?, "series"?, "scored"?}],
+//                "series"?: [{"fixed": {...}, "verdict", "error", "message"}]}],   // trends
+//    "counts": {verdict: number of claims}}
+// "parameter" is the run's value of "varying" (null when the claim varies none), "value" its
+// metric (a number, the mode string, or null), "series" the index of its trend series,
+// "scored" the score.json verdict of the acceptance entry naming the claim (when one does).
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace caplab::score {
+
+struct ClaimsOptions {
+  /// Only the claims whose id starts with this (e.g. "ch3."); empty: every claim.
+  std::string id_prefix;
+};
+
+/// Evaluates every claim of `claims` (a document {"claims": [...]}) against the runs in
+/// `run_dirs` (layout in the file header); reads, never writes. Throws core::InputError when
+/// `claims` has no "claims" array or a run directory does not exist.
+nlohmann::json evaluate_claims(const nlohmann::json& claims,
+                               const std::vector<std::filesystem::path>& run_dirs,
+                               const ClaimsOptions& options = {});
+
+/// evaluate_claims on the file `claims_file`; throws core::InputError when it cannot be read.
+nlohmann::json evaluate_claims(const std::filesystem::path& claims_file,
+                               const std::vector<std::filesystem::path>& run_dirs,
+                               const ClaimsOptions& options = {});
+
+/// The result as a text table (one row per claim, then the message of each inconsistent or
+/// undecided claim, then the counts).
+std::string format_claims(const nlohmann::json& result);
+
+/// Exit status of `caplab claims`: 0 when not `strict`; when `strict`, 1 if a claim is
+/// "inconsistent" (or the result is malformed), else 0.
+int claims_exit_code(const nlohmann::json& result, bool strict);
+
+}  // namespace caplab::score
