@@ -113,7 +113,7 @@ void check_grid(const CaseSpec& spec, const CaseDiagnostics& diag) {
 double circumscribed_radius(const ShapeSpec& shape) {
   const double a_eq = shape.diameter / 2;
   switch (shape.type) {
-    case ShapeSpec::Type::ellipse: return a_eq * std::sqrt(shape.aspect_ratio);
+    case ShapeSpec::Type::ellipse: return shape.semi_major();
     case ShapeSpec::Type::biconcave: return a_eq * shape.alpha / geometry::biconcave_equivalent_radius(shape.alpha);
     default: return a_eq;
   }

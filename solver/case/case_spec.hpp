@@ -7,6 +7,7 @@
 // reference velocity U (U∞, or k·a for shear flow), time in L/U (t·U∞/D, or k·t).
 #pragma once
 
+#include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -49,7 +50,8 @@ enum class BoundaryType {
 struct RigidMotionSpec {
   enum class Type { fixed, prescribed };
   Type type = Type::fixed;
-  /// fixed: at rest at shape.center; prescribed: the parsed segments (built by the loader).
+  /// Built by the loader for every rigid body: fixed, constant at shape.center / shape.angle;
+  /// prescribed, the parsed segments.
   std::optional<expr::RigidKinematics> kinematics;
 };
 
@@ -63,6 +65,11 @@ struct ShapeSpec {
   double aspect_ratio = 2.0;  ///< ellipse: semi-major over semi-minor axis (thesis ch. 3: 2)
   double alpha = 1.39;        ///< biconcave: cell radius ratio of thesis eq. 3.12 (red cell 1.39)
   double angle = 0.0;         ///< 2D shapes: rotation of the long axis from x, radians (counter-clockwise)
+
+  /// ellipse: the semi-axes along the long and the short body axis, in L (same area as the
+  /// equivalent circle: a b = (diameter/2)^2).
+  double semi_major() const { return 0.5 * diameter * std::sqrt(aspect_ratio); }
+  double semi_minor() const { return 0.5 * diameter / std::sqrt(aspect_ratio); }
 };
 
 /// Elastic membrane of a capsule (thesis ch. 3, eq. 3.1-3.10). Moduli as dimensionless groups.

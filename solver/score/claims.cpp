@@ -16,6 +16,7 @@
 #include "io/run_directory.hpp"
 #include "io/series_writer.hpp"
 #include "score/comparators.hpp"
+#include "score/run_files.hpp"
 
 namespace caplab::score {
 
@@ -56,12 +57,8 @@ const json& array_or_empty(const json& v) {
 
 json string_or_null(const std::string& s) { return s.empty() ? json(nullptr) : json(s); }
 
-json read_object(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) return json::object();
-  json doc = json::parse(in, nullptr, /*allow_exceptions=*/false);
-  return doc.is_object() ? doc : json::object();
-}
+/// A JSON file of the run directory, or {} when it is missing or unreadable.
+json read_object(const fs::path& file) { return read_json(file).doc.value_or(json::object()); }
 
 /// A run directory as the claims see it.
 struct Run {
@@ -87,8 +84,7 @@ json capsule_body(const json& case_doc) {
 json summary_value(const json& summary, const std::string& name) {
   const json& metrics = member(summary, "metrics");
   if (!metrics.is_object() || !metrics.contains(name)) return nullptr;
-  const json& m = metrics[name];
-  return m.is_object() ? member(m, "value") : m;
+  return metric_json(metrics[name]);
 }
 
 std::string mode_of(const Run& run) {

@@ -16,6 +16,7 @@
 #include "io/series_writer.hpp"
 #include "score/comparators.hpp"
 #include "score/reference_series.hpp"
+#include "score/run_files.hpp"
 
 namespace caplab::score {
 
@@ -26,22 +27,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr const char* kComparisons = "relative, absolute, bracket, time_series or mode";
-
-/// A JSON file of the run directory: its content, or why it could not be read.
-struct JsonFile {
-  std::optional<json> doc;
-  std::string problem;
-};
-
-JsonFile read_json(const fs::path& file) {
-  std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) return {std::nullopt, file.filename().string() + " is missing"};
-  std::ifstream in(file);
-  json doc = json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (doc.is_discarded()) return {std::nullopt, file.filename().string() + " is not valid JSON"};
-  if (!doc.is_object()) return {std::nullopt, file.filename().string() + " is not a JSON object"};
-  return {std::move(doc), ""};
-}
 
 std::string string_or(const json* doc, const char* key) {
   if (doc && doc->contains(key) && (*doc)[key].is_string()) return (*doc)[key].get<std::string>();
@@ -55,11 +40,6 @@ std::string joined_keys(const json& object) {
   std::string out;
   for (const auto& [key, _] : object.items()) out += (out.empty() ? "" : ", ") + key;
   return out.empty() ? "none" : out;
-}
-
-/// The value of a metric of summary.json: `x` of {"value": x, ...}, or the metric itself.
-const json& metric_json(const json& metric) {
-  return metric.is_object() && metric.contains("value") ? metric["value"] : metric;
 }
 
 /// A metric of summary.json as a number; NaN when it is not a number.

@@ -143,9 +143,11 @@ class Scene {
     Forcing forcing;
     Vec<D> force_on_body_lu = Vec<D>::Zero();
     double coefficient_scale = 1.0;  // 1 / (½ ρ U_lu² A_lu)
-    // Prescribed motion: the markers relative to the centre at the initial orientation, and
-    // what the internal-mass correction needs (ibm/internal_mass.hpp, rigid form).
-    std::optional<expr::RigidKinematics> kinematics;
+    // Kinematics (a fixed body's is constant). A moving body keeps its markers relative to the
+    // centre at the initial orientation, and what the internal-mass correction needs
+    // (ibm/internal_mass.hpp, rigid form).
+    std::optional<expr::RigidKinematics> kinematics;  // always set; optional only for default construction
+    bool moving = false;
     std::vector<Vec<D>> offsets;
     double angle0 = 0.0;
     double volume_lu = 0.0;
@@ -203,10 +205,9 @@ class Scene {
       double reference_lu = 0;
       if constexpr (D == 2) {
         if (b.shape.type == cases::ShapeSpec::Type::ellipse) {
-          const double major = 0.5 * b.shape.diameter * std::sqrt(b.shape.aspect_ratio);
-          body.markers = geometry::ellipse_markers(c, major, 0.25 * b.shape.diameter * b.shape.diameter / major,
-                                                   b.shape.angle, spacing);
-          reference_lu = 2 * major / h;
+          body.markers =
+              geometry::ellipse_markers(c, b.shape.semi_major(), b.shape.semi_minor(), b.shape.angle, spacing);
+          reference_lu = 2 * b.shape.semi_major() / h;
         } else {
           body.markers = geometry::circle_markers(c, b.shape.diameter, spacing);
           reference_lu = b.shape.diameter / h;
@@ -219,8 +220,10 @@ class Scene {
       body.coefficient_scale = 1.0 / (0.5 * units_.velocity_lu * units_.velocity_lu * reference_lu);
       for (double w : body.markers.weight) body.weight_lu.push_back(ibm::measure_to_lattice<D>(w, h));
       body.desired_lu.assign(body.markers.X.size(), Vec<D>::Zero());  // at rest until moved
+      CAPLAB_CHECK(b.motion && b.motion->kinematics, "rigid body '" + b.name + "' has no kinematics (load_case builds them)");
+      body.kinematics = b.motion->kinematics;
       if (b.is_moving()) {
-        body.kinematics = b.motion->kinematics;
+        body.moving = true;
         body.angle0 = b.shape.angle;
         for (const auto& X : body.markers.X) body.offsets.push_back(X - c);
         const double r_eq = 0.5 * b.shape.diameter / h;  // equivalent radius: same area/volume
@@ -424,7 +427,7 @@ class Scene {
     for (const auto& c : capsules_) c.restore(f, base);
     const double t = fine_steps_ * units_.blocks.back().dt;
     for (auto& b : bodies_)
-      if (b.kinematics) move_body(b, t);
+      if (b.moving) move_body(b, t);
     for (auto& b : bodies_) {
       try {
         std::visit(
@@ -432,7 +435,7 @@ class Scene {
               forcing.apply(pop.grid(), periodic_, b.markers.X, b.desired_lu, b.weight_lu, u_star, rho, f);
               // Moving: plus the inertia of the fluid inside (rigid form, rho = 1), exact a(t).
               b.force_on_body_lu = -forcing.total_force_on_fluid();
-              if (b.kinematics) b.force_on_body_lu += b.volume_lu * acceleration_lu(b.pose);
+              if (b.moving) b.force_on_body_lu += b.volume_lu * acceleration_lu(b.pose);
             },
             b.forcing);
       } catch (const core::NumericalError&) {
@@ -582,9 +585,9 @@ class Scene {
       } else if (q == "position") {
         for (const auto& b : bodies_) {
           // At the row's time (b.pose is that of the last IB stage, one fine step earlier).
-          const auto pose = b.kinematics ? b.kinematics->at(t) : expr::RigidPose{};
-          for (int a = 0; a < D; ++a) row[k++] = b.kinematics ? pose.x[a] : b.shape.center[a];
-          if constexpr (D == 2) row[k++] = b.kinematics ? pose.angle : b.shape.angle;
+          const auto pose = b.kinematics->at(t);
+          for (int a = 0; a < D; ++a) row[k++] = pose.x[a];
+          if constexpr (D == 2) row[k++] = pose.angle;
         }
       } else if (is_capsule_quantity(q)) {
         for (std::size_t c = 0; c < capsules_.size(); ++c) row[k++] = capsule_value(c, q);
