@@ -109,12 +109,25 @@ void check_grid(const CaseSpec& spec, const CaseDiagnostics& diag) {
   }
 }
 
+bool is_3d_shape(ShapeSpec::Type t) {
+  return t == ShapeSpec::Type::sphere || t == ShapeSpec::Type::oblate_spheroid ||
+         t == ShapeSpec::Type::biconcave_discoid;
+}
+
 // Radius of the smallest circle (sphere) about the centre that contains the shape, in L.
-double circumscribed_radius(const ShapeSpec& shape) {
+double circumscribed_radius(const BodySpec& body) {
+  const ShapeSpec& shape = body.shape;
   const double a_eq = shape.diameter / 2;
   switch (shape.type) {
     case ShapeSpec::Type::ellipse: return shape.semi_major();
     case ShapeSpec::Type::biconcave: return a_eq * shape.alpha / geometry::biconcave_equivalent_radius(shape.alpha);
+    case ShapeSpec::Type::oblate_spheroid: return a_eq * std::cbrt(shape.aspect_ratio);  // R^3 / s = a^3
+    case ShapeSpec::Type::biconcave_discoid: {
+      double r = 0;
+      for (const auto& x : capsule_mesh(shape, body.membrane ? body.membrane->subdivisions : 3).nodes)
+        r = std::max(r, x.norm());
+      return r;
+    }
     default: return a_eq;
   }
 }
@@ -125,36 +138,52 @@ void check_body_kind(const BodySpec& body, const std::string& at, int dimension,
                    fmt::format("exactly one of them for body \"{}\": \"motion\" for a rigid body, \"membrane\" "
                                "for a capsule",
                                body.name));
-  const bool two_d = body.shape.type != ShapeSpec::Type::sphere;
-  if (two_d != (dimension == 2))
+  const bool three_d = is_3d_shape(body.shape.type);
+  if (three_d != (dimension == 3))
     diag.fail(at + "/shape/type", json(enum_name(shape_type_names, body.shape.type)),
               fmt::format("a {}D shape for body \"{}\" since physics.dimension is {}: {}", dimension, body.name,
-                          dimension, dimension == 2 ? "\"circle\", \"ellipse\" or \"biconcave\"" : "\"sphere\""));
-  if (body.motion && body.shape.type == ShapeSpec::Type::biconcave)
+                          dimension,
+                          dimension == 2 ? "\"circle\", \"ellipse\" or \"biconcave\""
+                                         : "\"sphere\", \"oblate_spheroid\" or \"biconcave_discoid\""));
+  const bool capsule_only = body.shape.type == ShapeSpec::Type::biconcave ||
+                            body.shape.type == ShapeSpec::Type::oblate_spheroid ||
+                            body.shape.type == ShapeSpec::Type::biconcave_discoid;
+  if (body.motion && capsule_only)
     diag.fail(at + "/shape/type", json(enum_name(shape_type_names, body.shape.type)),
-              fmt::format("\"circle\", \"ellipse\" or \"sphere\" for the rigid body \"{}\" (the biconcave shape "
-                          "is a capsule shape)",
-                          body.name));
-  if (body.membrane && dimension != 2)
-    diag.fail(at + "/membrane", json("a membrane in 3D"),
-              "a capsule in 2D: 3D membranes (finite-element NH, SK, ZT laws) are not implemented yet; supported: "
-              "physics.dimension 2 with the \"hooke\" law");
+              fmt::format("\"circle\", \"ellipse\" or \"sphere\" for the rigid body \"{}\" (the {} shape is a "
+                          "capsule shape)",
+                          body.name, enum_name(shape_type_names, body.shape.type)));
 }
 
-// Marker spacing of a capsule in fine spacings, from the perimeter of its rest shape.
+// Mean distance between neighbouring membrane nodes, in fine spacings, from the rest shape.
 void check_membrane_resolution(const BodySpec& body, const std::string& at, double fine_spacing,
                                const CaseDiagnostics& diag) {
-  const auto nodes = geometry::ring_nodes(ring_shape(body.shape), Vec<2>::Zero(), body.shape.diameter / 2,
-                                          body.shape.angle, body.membrane->nodes);
-  double perimeter = 0;
-  for (std::size_t i = 0; i < nodes.size(); ++i) perimeter += (nodes[(i + 1) % nodes.size()] - nodes[i]).norm();
-  const double spacing = perimeter / body.membrane->nodes / fine_spacing;
+  const MembraneSpec& m = *body.membrane;
+  if (body.shape.center.size() == 2) {
+    const auto nodes =
+        geometry::ring_nodes(ring_shape(body.shape), Vec<2>::Zero(), body.shape.diameter / 2, body.shape.angle, m.nodes);
+    double perimeter = 0;
+    for (std::size_t i = 0; i < nodes.size(); ++i) perimeter += (nodes[(i + 1) % nodes.size()] - nodes[i]).norm();
+    const double spacing = perimeter / m.nodes / fine_spacing;
+    if (spacing > max_membrane_spacing_fine)
+      diag.fail(at + "/membrane/nodes", json(m.nodes),
+                fmt::format("at least {} nodes for body \"{}\": with {} the membrane nodes are {:.3g} fine spacings "
+                            "apart, above {}, and fluid leaks through the membrane",
+                            static_cast<int>(std::ceil(perimeter / (max_membrane_spacing_fine * fine_spacing))),
+                            body.name, m.nodes, spacing, max_membrane_spacing_fine));
+    return;
+  }
+  const auto mesh = capsule_mesh(body.shape, m.subdivisions);
+  double edges = 0;  // each interior edge counted twice, once per triangle: the mean is the same
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) edges += (mesh.nodes[t[(k + 1) % 3]] - mesh.nodes[t[k]]).norm();
+  const double spacing = edges / (3.0 * mesh.triangles.size()) / fine_spacing;
   if (spacing > max_membrane_spacing_fine)
-    diag.fail(at + "/membrane/nodes", json(body.membrane->nodes),
-              fmt::format("at least {} nodes for body \"{}\": with {} the membrane nodes are {:.3g} fine spacings "
-                          "apart, above {}, and fluid leaks through the membrane",
-                          static_cast<int>(std::ceil(perimeter / (max_membrane_spacing_fine * fine_spacing))),
-                          body.name, body.membrane->nodes, spacing, max_membrane_spacing_fine));
+    diag.fail(at + "/membrane/subdivisions", json(m.subdivisions),
+              fmt::format("at least {} subdivisions for body \"{}\": with {} the mean membrane edge is {:.3g} fine "
+                          "spacings, above {}, and fluid leaks through the membrane (each subdivision halves it)",
+                          m.subdivisions + static_cast<int>(std::ceil(std::log2(spacing / max_membrane_spacing_fine))),
+                          body.name, m.subdivisions, spacing, max_membrane_spacing_fine));
 }
 
 // A prescribed motion starts where the shape is and never jumps: the centre at t = 0 is
@@ -197,7 +226,7 @@ void check_path(const CaseSpec& spec, const BodySpec& body, const std::string& a
   const GridSpec& grid = spec.numerics.grid;
   const bool two_level = grid.refinement == GridSpec::Refinement::two_level;
   const double margin = body_margin_fine * grid.fine_spacing;
-  const double r = circumscribed_radius(body.shape);
+  const double r = circumscribed_radius(body);
   std::vector<double> times{0.0};
   if (body.is_moving()) {
     const double end = spec.numerics.end_time;
@@ -307,6 +336,46 @@ geometry::RingShape ring_shape(const ShapeSpec& shape) {
   r.aspect_ratio = shape.aspect_ratio;
   r.alpha = shape.alpha;
   return r;
+}
+
+// The membrane keys that belong to the dimension and the law, each required where it applies:
+// 2D rings take "nodes" and the bending keys, 3D meshes "subdivisions", Skalak "area_dilation".
+void check_membrane_keys(const json& raw, const std::string& at, const std::string& body, int dimension,
+                         const CaseDiagnostics& diag) {
+  const std::string law = raw.at("law").get<std::string>();
+  const bool ring_law = law == "hooke";
+  if (ring_law != (dimension == 2))
+    diag.fail(at + "/law", json(law),
+              dimension == 2 ? std::string("\"hooke\" in 2D (the finite-element laws are for 3D membranes)")
+                             : std::string("\"neo_hookean\", \"zero_thickness\" or \"skalak\" in 3D (\"hooke\" is the "
+                                           "2D ring law)"));
+  auto given = [&](const char* key) { return raw.contains(key); };
+  auto only = [&](const char* key, bool allowed, const std::string& where) {
+    if (given(key) && !allowed)
+      diag.fail(at + "/" + key, raw.at(key), fmt::format("no \"{}\" here: it applies {}", key, where));
+    if (!given(key) && allowed)
+      diag.fail_text(at, fmt::format("no \"{}\"", key),
+                     fmt::format("a \"{}\" for body \"{}\": it is required {}", key, body, where));
+  };
+  only("nodes", dimension == 2, "to 2D capsules (3D membranes take \"subdivisions\")");
+  only("subdivisions", dimension == 3, "to 3D capsules (2D membranes take \"nodes\")");
+  only("area_dilation", law == "skalak", "to the \"skalak\" law (C of thesis eq. 5.3)");
+  if (dimension == 3)
+    for (const char* key : {"bending_ratio", "reference_curvature"})
+      if (given(key))
+        diag.fail(at + "/" + key, raw.at(key),
+                  fmt::format("no \"{}\" in 3D: the finite-element membranes of thesis ch. 5 have no bending "
+                              "stiffness",
+                              key));
+}
+
+geometry::TriangleMesh capsule_mesh(const ShapeSpec& shape, int subdivisions) {
+  const double a = shape.diameter / 2;
+  switch (shape.type) {
+    case ShapeSpec::Type::oblate_spheroid: return geometry::oblate_spheroid(subdivisions, 1.0 / shape.aspect_ratio, a);
+    case ShapeSpec::Type::biconcave_discoid: return geometry::biconcave_discoid(subdivisions, a);
+    default: return geometry::octahedron_sphere(subdivisions, a);
+  }
 }
 
 void check_axis_lengths(const json& doc, int dimension, const std::vector<std::string>& per_axis_pointers,

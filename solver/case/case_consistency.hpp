@@ -11,6 +11,7 @@
 #include "case/case_diagnostics.hpp"
 #include "case/case_spec.hpp"
 #include "geometry/closed_curve.hpp"
+#include "geometry/triangle_mesh.hpp"
 
 namespace caplab::cases {
 
@@ -27,6 +28,15 @@ inline constexpr double max_membrane_spacing_fine = 2.0;
 
 /// The rest shape of a 2D capsule as the geometry module describes it.
 geometry::RingShape ring_shape(const ShapeSpec& shape);
+
+/// The rest mesh of a 3D capsule, centred at the origin, in L (thesis section 5.1.2).
+geometry::TriangleMesh capsule_mesh(const ShapeSpec& shape, int subdivisions);
+
+/// Checks that a membrane object (at JSON pointer `at`, of body `body`) has the keys of its
+/// dimension and law and no others: 2D "nodes" (and the bending keys), 3D "subdivisions",
+/// "skalak" "area_dilation"; the law itself matches the dimension.
+void check_membrane_keys(const nlohmann::json& membrane, const std::string& at, const std::string& body,
+                         int dimension, const CaseDiagnostics& diag);
 
 /// Checks that every array listed in `per_axis_pointers` has `dimension` entries.
 void check_axis_lengths(const nlohmann::json& doc, int dimension,

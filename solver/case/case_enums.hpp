@@ -36,9 +36,15 @@ inline constexpr std::array boundary_names{EnumName<BoundaryType>{"periodic", Bo
 inline constexpr std::array shape_type_names{EnumName<ShapeSpec::Type>{"circle", ShapeSpec::Type::circle},
                                              EnumName<ShapeSpec::Type>{"ellipse", ShapeSpec::Type::ellipse},
                                              EnumName<ShapeSpec::Type>{"biconcave", ShapeSpec::Type::biconcave},
-                                             EnumName<ShapeSpec::Type>{"sphere", ShapeSpec::Type::sphere}};
+                                             EnumName<ShapeSpec::Type>{"sphere", ShapeSpec::Type::sphere},
+                                             EnumName<ShapeSpec::Type>{"oblate_spheroid", ShapeSpec::Type::oblate_spheroid},
+                                             EnumName<ShapeSpec::Type>{"biconcave_discoid", ShapeSpec::Type::biconcave_discoid}};
 
-inline constexpr std::array membrane_law_names{EnumName<MembraneSpec::Law>{"hooke", MembraneSpec::Law::hooke}};
+inline constexpr std::array membrane_law_names{
+    EnumName<MembraneSpec::Law>{"hooke", MembraneSpec::Law::hooke},
+    EnumName<MembraneSpec::Law>{"neo_hookean", MembraneSpec::Law::neo_hookean},
+    EnumName<MembraneSpec::Law>{"zero_thickness", MembraneSpec::Law::zero_thickness},
+    EnumName<MembraneSpec::Law>{"skalak", MembraneSpec::Law::skalak}};
 
 inline constexpr std::array reference_curvature_names{
     EnumName<MembraneSpec::ReferenceCurvature>{"initial", MembraneSpec::ReferenceCurvature::initial},

@@ -102,7 +102,7 @@ SchemaNode build_case_schema() {
       req("name", text()),
       req("shape", object({req("type", choice(enum_names(shape_type_names))),
                            req("center", per_axis(number())), req("diameter", number(positive)),
-                           opt("aspect_ratio", number(at_least(1))),  // ellipse only
+                           opt("aspect_ratio", number(at_least(1))),  // ellipse, oblate_spheroid only
                            opt("alpha", number(positive)),            // biconcave only
                            opt("angle", number())})),                 // 2D only
       // prescribed only: "segments" (required there), "parameters" (case_consistency.cpp).
@@ -114,7 +114,9 @@ SchemaNode build_case_schema() {
       opt("membrane", object({req("law", choice(enum_names(membrane_law_names))),
                               req("capillary", number(positive)), opt("bending_ratio", number(at_least(0))),
                               opt("reference_curvature", choice(enum_names(reference_curvature_names))),
-                              req("nodes", integer(closed(8, 1e6)))})),
+                              opt("area_dilation", number(positive)),       // skalak only (required there)
+                              opt("nodes", integer(closed(8, 1e6))),        // 2D only (required there)
+                              opt("subdivisions", integer(closed(1, 7)))})),  // 3D only (required there)
   });
   const SchemaNode physics = object({
       req("dimension", integer(closed(2, 3))),

@@ -56,13 +56,17 @@ struct RigidMotionSpec {
 };
 
 struct ShapeSpec {
-  enum class Type { circle, ellipse, biconcave, sphere };
+  /// 2D: circle, ellipse, biconcave (eq. 3.12). 3D: sphere, oblate_spheroid (eq. 5.4) and
+  /// biconcave_discoid (eq. 5.5), both with their symmetry axis along z.
+  enum class Type { circle, ellipse, biconcave, sphere, oblate_spheroid, biconcave_discoid };
   Type type = Type::circle;
   std::vector<double> center;  ///< in L
-  /// In L: the diameter of a circle or sphere; for the other shapes the equivalent diameter
-  /// 2 (area/pi)^(1/2) (thesis eq. 3.9), i.e. twice the equivalent radius.
+  /// In L: the diameter of a circle or sphere; for the other shapes the equivalent diameter,
+  /// twice the equivalent radius: 2D 2 (area/pi)^(1/2) (thesis eq. 3.9), 3D 2 (3V/(4pi))^(1/3).
   double diameter = 1.0;
-  double aspect_ratio = 2.0;  ///< ellipse: semi-major over semi-minor axis (thesis ch. 3: 2)
+  /// ellipse: semi-major over semi-minor axis (thesis ch. 3: 2); oblate_spheroid: equatorial
+  /// over polar semi-axis (thesis "10:9", "3:2", "2:1").
+  double aspect_ratio = 2.0;
   double alpha = 1.39;        ///< biconcave: cell radius ratio of thesis eq. 3.12 (red cell 1.39)
   double angle = 0.0;         ///< 2D shapes: rotation of the long axis from x, radians (counter-clockwise)
 
@@ -72,15 +76,19 @@ struct ShapeSpec {
   double semi_minor() const { return 0.5 * diameter / std::sqrt(aspect_ratio); }
 };
 
-/// Elastic membrane of a capsule (thesis ch. 3, eq. 3.1-3.10). Moduli as dimensionless groups.
+/// Elastic membrane of a capsule: 2D rings with Hooke tension and bending (thesis ch. 3,
+/// eq. 3.1-3.10); 3D triangulated surfaces with finite-element forces from the strain energy
+/// (ch. 5, eq. 5.1-5.3). Moduli as dimensionless groups.
 struct MembraneSpec {
-  enum class Law { hooke };
+  enum class Law { hooke, neo_hookean, zero_thickness, skalak };
   enum class ReferenceCurvature { initial, circle, flat };
   Law law = Law::hooke;
-  double capillary = 0.04;    ///< G = mu k a / E (eq. 3.9)
-  double bending_ratio = 0.0; ///< E_b = E_B / (a^2 E) (eq. 3.10)
-  ReferenceCurvature reference_curvature = ReferenceCurvature::initial;  ///< kappa_0 of eq. 3.8
-  int nodes = 160;            ///< Lagrangian nodes, equally spaced in arc length
+  double capillary = 0.04;    ///< G = mu k a / E (eq. 3.9; 3D: E the modulus of eq. 5.1-5.3)
+  double bending_ratio = 0.0; ///< 2D: E_b = E_B / (a^2 E) (eq. 3.10)
+  ReferenceCurvature reference_curvature = ReferenceCurvature::initial;  ///< 2D: kappa_0 of eq. 3.8
+  double area_dilation = 1.0; ///< skalak: C of eq. 5.3 (area-dilation over shear modulus)
+  int nodes = 0;              ///< 2D: Lagrangian nodes, equally spaced in arc length (0 in 3D)
+  int subdivisions = 0;       ///< 3D: each octahedron face cut into 4^n triangles (5: 4098 nodes; 0 in 2D)
 };
 
 /// A rigid body (with `motion`) or, when `membrane` is set, a liquid-filled capsule whose

@@ -198,6 +198,8 @@ CaseSpec to_spec(const json& doc, const CaseDiagnostics& diag) {
     }
     if (b.contains("membrane")) {
       const json& m = b.at("membrane");
+      check_membrane_keys(m, child_pointer(child_pointer("/physics/bodies", physics.bodies.size()), "membrane"),
+                          body.name, physics.dimension, diag);
       MembraneSpec membrane;
       membrane.law = enum_value(membrane_law_names, m.at("law").get<std::string>());
       membrane.capillary = m.at("capillary").get<double>();
@@ -205,7 +207,9 @@ CaseSpec to_spec(const json& doc, const CaseDiagnostics& diag) {
       if (m.contains("reference_curvature"))
         membrane.reference_curvature =
             enum_value(reference_curvature_names, m.at("reference_curvature").get<std::string>());
-      membrane.nodes = m.at("nodes").get<int>();
+      membrane.area_dilation = m.value("area_dilation", membrane.area_dilation);
+      membrane.nodes = m.value("nodes", 0);
+      membrane.subdivisions = m.value("subdivisions", 0);
       body.membrane = membrane;
     }
     physics.bodies.push_back(std::move(body));
@@ -286,10 +290,11 @@ void complete(CaseSpec& spec, json& resolved) {
   for (std::size_t i = 0; i < spec.physics.bodies.size(); ++i) {
     const BodySpec& body = spec.physics.bodies[i];
     json& b = resolved["physics"]["bodies"][i];
-    if (body.shape.type == ShapeSpec::Type::ellipse) b["shape"]["aspect_ratio"] = body.shape.aspect_ratio;
+    if (body.shape.type == ShapeSpec::Type::ellipse || body.shape.type == ShapeSpec::Type::oblate_spheroid)
+      b["shape"]["aspect_ratio"] = body.shape.aspect_ratio;
     if (body.shape.type == ShapeSpec::Type::biconcave) b["shape"]["alpha"] = body.shape.alpha;
     if (spec.physics.dimension == 2) b["shape"]["angle"] = body.shape.angle;
-    if (body.membrane) {
+    if (body.membrane && spec.physics.dimension == 2) {
       b["membrane"]["bending_ratio"] = body.membrane->bending_ratio;
       b["membrane"]["reference_curvature"] =
           enum_name(reference_curvature_names, body.membrane->reference_curvature);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/error.hpp"
 
@@ -37,14 +38,45 @@ int reversals(std::span<const double> v, double swing) {
   return turns;
 }
 
+// Whole turns of v by `turn` from v[first], in the sense v ends up moving, and the time the
+// last one completed (linear interpolation between samples).
+struct Turns {
+  int count = 0;
+  double t_last = 0;
+};
+Turns whole_turns(std::span<const double> t, std::span<const double> v, std::size_t first, double turn) {
+  const std::size_t last = t.size() - 1;
+  const double sense = v[last] < v[first] ? -1.0 : 1.0;
+  double level = v[first] + sense * turn;
+  Turns r{0, t[first]};
+  for (std::size_t k = first + 1; k <= last; ++k)
+    while ((v[k] - level) * sense >= 0) {  // crossed: interpolate the time
+      const double s = (level - v[k - 1]) / (v[k] - v[k - 1]);
+      r.t_last = t[k - 1] + s * (t[k] - t[k - 1]);
+      ++r.count, level += sense * turn;
+    }
+  return r;
+}
+
+std::size_t window_start(std::span<const double> t, std::span<const double> v, double t_from, const char* what) {
+  CAPLAB_CHECK(t.size() == v.size(), std::string(what) + ": time and angle need the same number of samples");
+  const std::size_t first = std::lower_bound(t.begin(), t.end(), t_from) - t.begin();
+  CAPLAB_CHECK(t.size() >= first + 3, std::string(what) + ": fewer than 3 samples after the start of the window");
+  return first;
+}
+
 }  // namespace
+
+std::optional<double> revolution_rate(std::span<const double> t, std::span<const double> phase, double t_from) {
+  const std::size_t first = window_start(t, phase, t_from, "revolution rate");
+  const Turns r = whole_turns(t, phase, first, 2 * std::numbers::pi);
+  if (r.count == 0) return std::nullopt;
+  return 2 * std::numbers::pi * r.count / (r.t_last - t[first]);
+}
 
 CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const double> inclination,
                                       double t_from, double oscillation_threshold) {
-  CAPLAB_CHECK(t.size() == inclination.size(),
-               "capsule motion: time and inclination need the same number of samples");
-  const std::size_t first = std::lower_bound(t.begin(), t.end(), t_from) - t.begin();
-  CAPLAB_CHECK(t.size() >= first + 3, "capsule motion: fewer than 3 samples after the start of the window");
+  const std::size_t first = window_start(t, inclination, t_from, "capsule motion");
   const std::size_t last = t.size() - 1;
 
   CapsuleMotion m;
@@ -56,18 +88,10 @@ CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const
   const double span = t[last] - t[first];
   if (m.inclination_turn > std::numbers::pi) {
     m.mode = "tumbling";
-    const double sense = inclination[last] < inclination[first] ? -1.0 : 1.0;
-    double level = inclination[first] + sense * std::numbers::pi, t_last_turn = t[first];
-    int turns = 0;
-    for (std::size_t k = first + 1; k <= last; ++k)
-      while ((inclination[k] - level) * sense >= 0) {  // crossed: interpolate the time
-        const double s = (level - inclination[k - 1]) / (inclination[k] - inclination[k - 1]);
-        t_last_turn = t[k - 1] + s * (t[k] - t[k - 1]);
-        ++turns, level += sense * std::numbers::pi;
-      }
+    const Turns turns = whole_turns(t, inclination, first, std::numbers::pi);
     const double turn = std::abs(inclination[last] - inclination[first]);
-    if (turns > 0)
-      m.tumbling_period = (t_last_turn - t[first]) / turns;
+    if (turns.count > 0)
+      m.tumbling_period = (turns.t_last - t[first]) / turns.count;
     else if (turn > 0)
       m.tumbling_period = std::numbers::pi * span / turn;
   } else {

@@ -61,4 +61,10 @@ CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const
                                       double t_from,
                                       double oscillation_threshold = default_oscillation_threshold);
 
+/// Mean turning rate (rad per unit time, positive) of a continuous phase over its whole
+/// revolutions in t >= t_from: 2 pi N / (t_N - t_from), t_N the time the phase first differs
+/// from its value at t_from by N whole turns; nullopt when it does not complete one. Throws
+/// core::Error when fewer than 3 samples lie in the window or the lengths differ.
+std::optional<double> revolution_rate(std::span<const double> t, std::span<const double> phase, double t_from);
+
 }  // namespace caplab::diagnostics

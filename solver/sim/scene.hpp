@@ -36,6 +36,7 @@
 #include "io/snapshot_writer.hpp"
 #include "membrane/ring_membrane.hpp"
 #include "sim/capsule.hpp"
+#include "sim/capsule_track.hpp"
 #include "sim/fluid.hpp"
 #include "sim/units.hpp"
 
@@ -243,11 +244,13 @@ class Scene {
     const auto& m = *b.membrane;
     const double a = 0.5 * b.shape.diameter;  // equivalent radius, in L
     // Moduli in lattice units of the finest block: E = mu k a / G with mu = rho nu (rho = 1)
-    // and k a = U (the lattice velocity); E_B = E_b a^2 E with a in L (positions are in L).
+    // and k a = U (the lattice velocity).
     const double E = units_.blocks.back().nu_lu * units_.velocity_lu / m.capillary;
-    const double E_B = m.bending_ratio * a * a * E;
+    Vec<D> c;
+    for (int k = 0; k < D; ++k) c[k] = b.shape.center[k];
     if constexpr (D == 2) {
-      Vec<2> c(b.shape.center[0], b.shape.center[1]);
+      // Positions are in L: E_B = E_b a^2 E with a in L.
+      const double E_B = m.bending_ratio * a * a * E;
       auto rest = geometry::ring_nodes(cases::ring_shape(b.shape), c, a, b.shape.angle, m.nodes);
       auto kappa0 = membrane::ReferenceCurvature::initial;
       if (m.reference_curvature == cases::MembraneSpec::ReferenceCurvature::circle)
@@ -256,15 +259,20 @@ class Scene {
         kappa0 = membrane::ReferenceCurvature::flat;
       auto ring = std::make_unique<membrane::RingMembrane>(rest, E, E_B, kappa0);
       capsules_.emplace_back(b.name, std::move(rest), std::move(ring), make_transfer());
-      CapsuleTrack track;
-      const auto shape = diagnostics::equivalent_ellipse(capsules_.back().positions());
-      track.area0 = shape.area;
-      track.shape = shape;
-      capsule_tracks_.push_back(track);
-      track_capsules();
+      capsule_tracks_.emplace_back(capsules_.back());
     } else {
-      throw core::InputError(spec_.source_file, "/physics/bodies", b.name,
-                             "a capsule in 2D (3D membranes are not implemented yet)");
+      // Node forces of a surface modulus scale with length (f ~ E A0 / l): with positions in L
+      // the modulus E / h gives forces in lattice units (h = fine spacing in L).
+      auto mesh = cases::capsule_mesh(b.shape, m.subdivisions);
+      for (auto& x : mesh.nodes) x += c;
+      const double E_L = E / fluid_.finest().pop.grid().dx();
+      membrane::MembraneLaw law = membrane::NeoHookean{E_L};
+      if (m.law == cases::MembraneSpec::Law::zero_thickness) law = membrane::ZeroThickness{E_L};
+      if (m.law == cases::MembraneSpec::Law::skalak) law = membrane::Skalak{E_L, m.area_dilation};
+      auto fem = std::make_unique<membrane::FemMembrane>(mesh, law);
+      const auto& fem_ref = *fem;
+      capsules_.emplace_back(b.name, std::move(mesh.nodes), std::move(fem), make_transfer());
+      capsule_tracks_.emplace_back(capsules_.back(), fem_ref);
     }
   }
 
@@ -276,22 +284,9 @@ class Scene {
     }
   }
 
-  /// Shape of each capsule after a step: equivalent ellipse, continuous inclination and
-  /// membrane phase (unwrapped every coarse step, so tumbling is followed at any sampling).
+  /// Shape of each capsule after a coarse step (capsule_track.hpp).
   void track_capsules() {
-    if constexpr (D == 2) {
-      for (std::size_t c = 0; c < capsules_.size(); ++c) {
-        auto& tr = capsule_tracks_[c];
-        const auto X = capsules_[c].positions();
-        tr.shape = diagnostics::equivalent_ellipse(X);
-        // The axis of a nearly round capsule means nothing: follow it only once D_xy says
-        // there is one (an initially circular capsule starts at D = 0).
-        if (tr.shape.taylor < round_capsule_taylor) tr.inclination.reset();
-        tr.theta = tr.inclination(tr.shape.inclination);
-        const Vec<2> r = X[0] - tr.shape.centroid;
-        tr.phi = tr.phase(std::atan2(r[1], r[0]));
-      }
-    }
+    for (std::size_t c = 0; c < capsules_.size(); ++c) capsule_tracks_[c].update(capsules_[c]);
   }
 
   /// Transverse velocity blob (lattice units) 1.5 D downstream of each body, width D/2
@@ -513,64 +508,30 @@ class Scene {
         if (capsules_.empty())
           throw core::InputError(spec_.source_file, "/outputs/series/quantities", q,
                                  "a quantity of a scene with capsules (this case has none)");
+        const auto& info = capsule_quantity(q);
         for (const auto& c : capsules_)
-          columns_.push_back({capsules_.size() > 1 ? c.name() + "." + q : q, capsule_unit(q), capsule_definition(q)});
+          columns_.push_back({capsules_.size() > 1 ? c.name() + "." + q : q, std::string(info.unit),
+                              std::string(info.definition)});
       } else if (q == "mass") {
         columns_.push_back({"mass", "1", "total fluid mass over its initial value"});
       } else if (q == "kinetic_energy") {
         columns_.push_back({"kinetic_energy", "rho U^2 L^D", "integral of rho u^2 / 2 over the domain"});
       } else {
+        std::string names = "drag_coefficient, lift_coefficient, position";
+        for (const auto& info : CapsuleTrack<D>::quantities) names += ", " + std::string(info.name);
         throw core::InputError(spec_.source_file, "/outputs/series/quantities", q,
-                               "one of drag_coefficient, lift_coefficient, position, taylor_deformation, inclination, "
-                               "area_change, tank_treading_phase, tank_treading_period, mass, kinetic_energy");
+                               fmt::format("one of {}, mass, kinetic_energy ({}D)", names, D));
       }
     }
   }
 
   static bool is_capsule_quantity(const std::string& q) {
-    return q == "taylor_deformation" || q == "inclination" || q == "area_change" || q == "tank_treading_phase" ||
-           q == "tank_treading_period";
+    const auto& list = CapsuleTrack<D>::quantities;
+    return std::any_of(list.begin(), list.end(), [&](const CapsuleQuantity& c) { return c.name == q; });
   }
-  static std::string capsule_unit(const std::string& q) {
-    if (q == "tank_treading_period") return "1/k";
-    return q == "inclination" || q == "tank_treading_phase" ? "rad" : "1";
-  }
-  static std::string capsule_definition(const std::string& q) {
-    if (q == "taylor_deformation")
-      return "D_xy = (L - B)/(L + B), L, B semi-axes of the ellipse with the inertia tensor of the enclosed area "
-             "(thesis eq. 2.33)";
-    if (q == "inclination")
-      return "angle of the major axis of that ellipse from the x axis, continuous in time (tumbling keeps "
-             "decreasing); counter-clockwise positive";
-    if (q == "area_change") return "enclosed area over its initial value, minus 1";
-    if (q == "tank_treading_period")
-      return "T = sum over segments of length / |tangential membrane velocity|: the time a node takes to go once "
-             "around the current contour (exact for a steady tank-treading shape)";
-    return "angle of membrane node 0 about the centroid, continuous in time (tank-treading: decreasing)";
-  }
-  double capsule_value(std::size_t c, const std::string& q) const {
-    const auto& tr = capsule_tracks_[c];
-    if (q == "taylor_deformation") return tr.shape.taylor;
-    if (q == "inclination") return tr.theta;
-    if (q == "area_change") return tr.shape.area / tr.area0 - 1.0;
-    if (q == "tank_treading_period") return tank_treading_period(capsules_[c]);
-    return tr.phi;
-  }
-
-  /// sum_i l_i / |v_t,i| over the segments of the contour, v_t the tangential component of the
-  /// mean node velocity of the segment, in k a (so T is in 1/k).
-  double tank_treading_period(const Capsule<D>& c) const {
-    const auto X = c.positions();
-    const auto U = c.velocities();
-    double period = 0;
-    for (std::size_t i = 0; i < X.size(); ++i) {
-      const std::size_t j = i + 1 == X.size() ? 0 : i + 1;
-      const Vec<D> d = X[j] - X[i];
-      const double l = d.norm();
-      const double v_t = 0.5 * (U[i] + U[j]).dot(d) / l / units_.velocity_lu;
-      period += l / std::abs(v_t);
-    }
-    return period;
+  static const CapsuleQuantity& capsule_quantity(const std::string& q) {
+    const auto& list = CapsuleTrack<D>::quantities;
+    return *std::find_if(list.begin(), list.end(), [&](const CapsuleQuantity& c) { return c.name == q; });
   }
 
   void sample(double t, std::vector<double>& row) {
@@ -590,7 +551,8 @@ class Scene {
           if constexpr (D == 2) row[k++] = pose.angle;
         }
       } else if (is_capsule_quantity(q)) {
-        for (std::size_t c = 0; c < capsules_.size(); ++c) row[k++] = capsule_value(c, q);
+        for (std::size_t c = 0; c < capsules_.size(); ++c)
+          row[k++] = capsule_tracks_[c].value(q, capsules_[c], units_.velocity_lu);
       } else if (q == "mass") {
         row[k++] = total_mass() / mass0_;
       } else if (q == "kinetic_energy") {
@@ -716,11 +678,8 @@ class Scene {
         const auto segs = io::closed_ring_segments(static_cast<int>(b.markers.X.size()));
         w.add_mesh_step(t, b.name, b.markers.X, segs);
       }
-      for (const auto& c : capsules_) {
-        const auto segs = io::closed_ring_segments(static_cast<int>(c.positions().size()));
-        w.add_mesh_step(t, c.name(), c.positions(), segs);
-      }
     }
+    for (std::size_t c = 0; c < capsules_.size(); ++c) capsule_tracks_[c].add_to_snapshot(w, t, capsules_[c]);
   }
 
   nlohmann::json summarise(const io::RunDirectory& dir) const {
@@ -773,15 +732,25 @@ class Scene {
       const auto* v = column(q);
       if (!v) continue;
       const auto s = diagnostics::analyse_signal(t, *v, from);
-      const std::string unit = capsule_unit(q);
+      const std::string unit(capsule_quantity(q).unit);
       metrics[prefix + q + "_mean"] = {{"value", s.mean}, {"unit", unit}, {"definition", "time average" + window}};
       metrics[prefix + q + "_amplitude"] = {{"value", s.amplitude}, {"unit", unit}, {"definition", "(max - min)/2" + window}};
     }
-    if (const auto* v = column("area_change")) {
+    for (const char* q : {"area_change", "volume_change", "surface_area_change", "max_area_change"}) {
+      const auto* v = column(q);
+      if (!v) continue;
       double worst = 0;
       for (double x : *v) worst = std::max(worst, std::abs(x));
-      metrics[prefix + "area_change_max"] = {
-          {"value", worst}, {"unit", "1"}, {"definition", "largest |A/A0 - 1| of the enclosed area over the run"}};
+      metrics[prefix + q + "_max"] = {
+          {"value", worst}, {"unit", "1"},
+          {"definition", "largest absolute value over the run of: " + std::string(capsule_quantity(q).definition)}};
+    }
+    for (const char* q : {"length", "width", "thickness"}) {
+      const auto* v = column(q);
+      if (!v) continue;
+      const auto s = diagnostics::analyse_signal(t, *v, from);
+      metrics[prefix + q + "_mean"] = {{"value", s.mean}, {"unit", "L"}, {"definition", "time average" + window}};
+      metrics[prefix + q + "_amplitude"] = {{"value", s.amplitude}, {"unit", "L"}, {"definition", "(max - min)/2" + window}};
     }
     const auto* theta = column("inclination");
     if (!theta) return;
@@ -815,17 +784,17 @@ class Scene {
           {"value", 2.0 * std::numbers::pi / T_tt},
           {"unit", "1"},
           {"definition", "f / k = 2 pi / (k T)" + window + " (thesis ch. 4 normalisation)"}};
+    } else if (const auto* phase = column("tank_treading_phase")) {
+      // 3D: whole revolutions of the tracked node only (a part revolution on a deformed shape
+      // turns unevenly, see above).
+      if (const auto rate = diagnostics::revolution_rate(t, *phase, from))
+        metrics[prefix + "tank_treading_frequency_per_k"] = {
+            {"value", *rate / (2 * std::numbers::pi)},
+            {"unit", "1"},
+            {"definition", "f / k: whole revolutions of the tracked node (series tank_treading_phase) per k t" +
+                               window + " (thesis ch. 6 normalisation)"}};
     }
   }
-
-  struct CapsuleTrack {
-    diagnostics::EquivalentEllipse shape;
-    diagnostics::AngleUnwrapper inclination{std::numbers::pi}, phase{2 * std::numbers::pi};
-    double area0 = 1.0;
-    double theta = 0.0, phi = 0.0;
-  };
-  /// Below this D_xy an initially circular capsule has no axis worth following.
-  static constexpr double round_capsule_taylor = 1e-4;
 
   const cases::CaseSpec& spec_;
   LatticeUnits units_;
@@ -840,7 +809,7 @@ class Scene {
   std::vector<std::uint32_t> stamp_;
   std::uint32_t stamp_now_ = 0;
   std::vector<Vec<D>> velocity_;
-  std::vector<CapsuleTrack> capsule_tracks_;
+  std::vector<CapsuleTrack<D>> capsule_tracks_;
   std::array<bool, D> periodic_{};
   std::vector<io::SeriesColumn> columns_;
   double mass0_ = 1.0;

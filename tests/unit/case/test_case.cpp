@@ -707,7 +707,7 @@ TEST(case_capsule, RejectsUnsupportedCombinations) {
   sphere_capsule["physics"]["bodies"][0]["shape"]["type"] = "sphere";
   expect_doc_rejected(sphere_capsule, "/physics/bodies/0/shape/type", {"2D shape", "ellipse"});
   // A capsule quantity in a scene without capsules is an input error of the scene builder
-  // (sim), not of the loader; a membrane in 3D is refused here.
+  // (sim), not of the loader; the 2D ring law in 3D is refused here.
   json three_d = capsule_json();
   three_d["physics"]["dimension"] = 3;
   three_d["physics"]["domain"]["size"] = {16, 16, 16};
@@ -718,7 +718,75 @@ TEST(case_capsule, RejectsUnsupportedCombinations) {
   three_d["numerics"]["grid"]["fine_region"] = {{"min", {5, 5, 5}}, {"max", {11, 11, 11}}};
   three_d["fidelity"] = {{"standard", json::object()}};
   three_d.erase("acceptance");
-  expect_doc_rejected(three_d, "/physics/bodies/0/membrane", {"3D membranes", "not implemented"});
+  expect_doc_rejected(three_d, "/physics/bodies/0/membrane/law", {"\"hooke\"", "neo_hookean", "in 3D"});
+}
+
+// ---------------------------------------------------------------- 3D capsules
+const fs::path sphere_capsule_file = source_dir / "catalogue/ch5/sphere_nh_G0.05.json";
+json sphere_capsule_json() { return read_case_json(sphere_capsule_file); }
+json& membrane_of(json& doc) { return doc["physics"]["bodies"][0]["membrane"]; }
+
+TEST(case_capsule3d, LoadsLawMeshAndShape) {
+  const CaseSpec spec = load_case(sphere_capsule_file, "standard");
+  const BodySpec& b = spec.physics.bodies.at(0);
+  ASSERT_TRUE(b.is_capsule());
+  EXPECT_EQ(b.shape.type, ShapeSpec::Type::sphere);
+  EXPECT_EQ(b.membrane->law, MembraneSpec::Law::neo_hookean);
+  EXPECT_EQ(b.membrane->subdivisions, 5);
+  EXPECT_EQ(b.membrane->nodes, 0);
+  EXPECT_EQ(load_case(sphere_capsule_file, "quick").physics.bodies[0].membrane->subdivisions, 4);
+  // The 2D bending keys are not written into a 3D case.
+  EXPECT_FALSE(spec.resolved["physics"]["bodies"][0]["membrane"].contains("bending_ratio"));
+  const CaseSpec sk = load_case(source_dir / "catalogue/ch5/biconcave_sk_G0.6.json", "standard");
+  EXPECT_EQ(sk.physics.bodies[0].membrane->law, MembraneSpec::Law::skalak);
+  EXPECT_DOUBLE_EQ(sk.physics.bodies[0].membrane->area_dilation, 200.0);
+  EXPECT_EQ(sk.physics.bodies[0].shape.type, ShapeSpec::Type::biconcave_discoid);
+}
+
+TEST(case_capsule3d, RejectsKeysOfTheOtherDimensionOrLaw) {
+  json doc = sphere_capsule_json();
+  membrane_of(doc)["nodes"] = 4098;
+  expect_doc_rejected(doc, "/physics/bodies/0/membrane/nodes", {"no \"nodes\"", "2D capsules", "subdivisions"});
+  doc = sphere_capsule_json();
+  membrane_of(doc).erase("subdivisions");
+  expect_doc_rejected(doc, "/physics/bodies/0/membrane", {"\"subdivisions\"", "required", "3D capsules"});
+  doc = sphere_capsule_json();
+  membrane_of(doc)["area_dilation"] = 1;
+  expect_doc_rejected(doc, "/physics/bodies/0/membrane/area_dilation", {"\"skalak\"", "eq. 5.3"});
+  doc = sphere_capsule_json();
+  membrane_of(doc)["law"] = "skalak";
+  expect_doc_rejected(doc, "/physics/bodies/0/membrane", {"\"area_dilation\"", "required"});
+  doc = sphere_capsule_json();
+  membrane_of(doc)["bending_ratio"] = 0.01;
+  expect_doc_rejected(doc, "/physics/bodies/0/membrane/bending_ratio", {"no bending stiffness"});
+  doc = sphere_capsule_json();
+  membrane_of(doc)["area_dilation"] = -1;
+  membrane_of(doc)["law"] = "skalak";
+  expect_doc_rejected(doc, "/physics/bodies/0/membrane/area_dilation", {"> 0"});
+}
+
+TEST(case_capsule3d, RejectsACoarseMeshAnd2DShapesAndRigidSpheroids) {
+  // n = 2: 66 nodes on the sphere of radius 1, mean edge ~0.36 L = 4.4 fine spacings at a/12.
+  expect_rejected([] { load_case(sphere_capsule_file, "standard", {"physics.bodies.0.membrane.subdivisions=2"}); },
+                  "/physics/bodies/0/membrane/subdivisions", {"at least 4 subdivisions", "fine spacings", "leaks"});
+  expect_rejected([] { load_case(sphere_capsule_file, "standard", {"physics.bodies.0.shape.type=ellipse"}); },
+                  "/physics/bodies/0/shape/type", {"3D shape", "\"oblate_spheroid\""});
+  json rigid = sphere_capsule_json();
+  rigid["physics"]["bodies"][0].erase("membrane");
+  rigid["physics"]["bodies"][0]["motion"] = {{"type", "fixed"}};
+  rigid["physics"]["bodies"][0]["shape"]["type"] = "oblate_spheroid";
+  expect_doc_rejected(rigid, "/physics/bodies/0/shape/type", {"rigid body", "capsule shape"});
+}
+
+TEST(case_capsule3d, RejectsAnOblateCapsuleReachingOutOfTheFineBlock) {
+  // A 2:1 oblate spheroid of equivalent radius 1 has the equatorial radius 2^(1/3) = 1.26.
+  expect_rejected(
+      [] {
+        load_case(sphere_capsule_file, "standard",
+                  {"physics.bodies.0.shape.type=oblate_spheroid", "physics.bodies.0.shape.aspect_ratio=2",
+                   "physics.bodies.0.shape.center=[4.4, 5, 5]"});
+      },
+      "/physics/bodies/0/shape/center", {"fine region", "reaching 1.26"});
 }
 
 // ---------------------------------------------------------------- moving rigid bodies
