@@ -25,7 +25,7 @@ from pathlib import Path
 
 import jinja2
 
-from . import capsule, cylinder, figures, moving
+from . import capsule, capsule3d, cylinder, figures, moving
 from .references import KIND_LABELS, ReferenceLibrary, claim_summary, parameters_text
 from .runs import (Run, catalogue_cases, chapter_slug, chapter_sort_key, chapter_title, discover,
                    finite, with_missing)
@@ -330,6 +330,10 @@ def build_report(results: Path, out: Path, references: Path | None = None, catal
             for ds in capsules.datasets:
                 used[ds.anchor] = ds
             result.problems += [f"{chapter}: {p}" for p in capsules.problems]
+            capsules3d = capsule3d.build(chapter_runs, refs, chapter)
+            for ds in capsules3d.datasets:
+                used[ds.anchor] = ds
+            result.problems += [f"{chapter}: {p}" for p in capsules3d.problems]
             motions = moving.build(chapter_runs, refs, chapter)
             for ds in motions.datasets:
                 used[ds.anchor] = ds
@@ -351,6 +355,7 @@ def build_report(results: Path, out: Path, references: Path | None = None, catal
                 title=f"caplab report — {chapter_title(chapter)}", chapter=chapter,
                 chapter_title=chapter_title(chapter), runs=chapter_runs, views=views, counts=counts(chapter_runs),
                 tables=tables, capsules=capsules, moving=motions, datasets=sorted(used.values(), key=lambda d: d.rel),
+                capsules3d=capsules3d,
                 conventions=conventions,
                 builds=builds,
                 env_rows=env_rows, meta=meta, cost_figure=figures.cost_vs_error(chapter_runs),

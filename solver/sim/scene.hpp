@@ -11,6 +11,7 @@
 // rigid bodies and then move with the velocity of the whole force field.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -356,6 +357,11 @@ class Scene {
           },
           b.forcing);
     for (const auto& c : capsules_) c.for_each_stencil_node(add);
+    // In memory order: the forced collision and the velocity gather then walk the block's rows
+    // instead of jumping between the rows of each stencil (measured: the forced collision of
+    // a 3D capsule's ~10k stencil nodes cost five unforced updates per node unsorted).
+    std::sort(forced_nodes_.begin(), forced_nodes_.end());
+    for (std::size_t k = 0; k < forced_nodes_.size(); ++k) slot_[forced_nodes_[k]] = static_cast<std::int32_t>(k);
   }
 
   /// Membrane forces, spreading, and the markers' move with the forced velocity (capsule.hpp).

@@ -97,6 +97,22 @@ TEST(CapsuleMotion, JefferyOrbitTumblesWithItsPeriod) {
   EXPECT_NEAR(*p.tumbling_period, half_period, 1e-3 * half_period);
 }
 
+TEST(RevolutionRate, CountsWholeTurnsOfAnUnevenPhase) {
+  // A node turning clockwise at the mean rate 0.3 with a 40 % modulation per revolution (as on
+  // a deformed contour): whole revolutions give the mean rate exactly, whatever the window.
+  const double w = 0.3;
+  auto phase = [&](double t) { return -(w * t + 0.4 * std::sin(w * t)); };
+  const auto s = sample(100, 1e-3, phase);
+  for (const double from : {0.0, 7.3, 31.0}) {
+    const auto r = revolution_rate(s.t, s.theta, from);
+    ASSERT_TRUE(r.has_value()) << from;
+    EXPECT_NEAR(*r, w, 2e-3 * w) << from;
+  }
+  // Less than one revolution in the window: no rate.
+  EXPECT_FALSE(revolution_rate(s.t, s.theta, 85.0).has_value());
+  EXPECT_THROW(revolution_rate(s.t, s.theta, 100.0), core::Error);
+}
+
 TEST(CapsuleMotion, RejectsShortOrMismatchedInput) {
   const std::vector<double> t{0, 1, 2, 3}, a{0, 0, 0, 0}, shorter{0, 0, 0};
   EXPECT_THROW(classify_capsule_motion(t, shorter, 0), core::Error);
