@@ -650,7 +650,10 @@ def build(runs: list[Run], refs: ReferenceLibrary, chapter: str) -> Capsules:
         return section
     cache: dict = {}
     by_family: dict[tuple, list[Run]] = {}
-    for run in section.runs:
+    # Families, contours and convergence series are the 2D rings'; 3D capsules have their own
+    # section (capsule3d.py). The thesis statements below are checked for both.
+    rings = [r for r in section.runs if r.dimension != 3]
+    for run in rings:
         if capsule_body(run) is None:
             section.problems.append(f"{run.case_id}: no capsule body in case.json; not placed in a family")
             continue
@@ -676,7 +679,7 @@ def build(runs: list[Run], refs: ReferenceLibrary, chapter: str) -> Capsules:
             family.problems.append("no run of this family has a capsule series in series.h5")
         section.families.append(family)
     try:
-        section.series = series_groups(section.runs, cache)
+        section.series = series_groups(rings, cache)
     except Exception as err:
         section.problems.append(f"convergence series failed: {err}")
 

@@ -77,7 +77,7 @@ MAX_SECTION_PANELS = 16
 # ---- what a 3D capsule run is ----------------------------------------------------------------------
 
 def is_capsule3d(run: Run) -> bool:
-    return run.physics.get("dimension") == 3 and capsule.capsule_body(run) is not None
+    return run.dimension == 3 and capsule.capsule_body(run) is not None
 
 
 def params(run: Run) -> dict:

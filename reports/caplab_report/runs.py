@@ -139,6 +139,11 @@ class Run:
         return phys if isinstance(phys, dict) else {}
 
     @property
+    def dimension(self) -> int | None:
+        d = self.physics.get("dimension")
+        return d if isinstance(d, int) else None
+
+    @property
     def bodies(self) -> list[dict]:
         bodies = self.physics.get("bodies")
         return [b for b in bodies if isinstance(b, dict)] if isinstance(bodies, list) else []
