@@ -111,15 +111,17 @@ void FemMembrane::check_size(const char* what, std::size_t size, std::size_t exp
   CAPLAB_CHECK(false, msg.str());
 }
 
-inline void FemMembrane::deformation_gradient(std::size_t e, std::span<const Vec<3>> X, Vec<3>& F1,
-                                              Vec<3>& F2) const {
+inline FemMembrane::Deformation FemMembrane::deformation(std::size_t e, std::span<const Vec<3>> X) const {
   const auto& t = triangles_[e];
   const auto& g = shape_gradients_[e];
   // F = sum_a x_a grad N_a^T = (x1 - x0) grad N_1^T + (x2 - x0) grad N_2^T.
   const Vec<3> e1 = X[t[1]] - X[t[0]];
   const Vec<3> e2 = X[t[2]] - X[t[0]];
-  F1 = g[0] * e1 + g[2] * e2;
-  F2 = g[1] * e1 + g[3] * e2;
+  Deformation d;
+  d.F1 = g[0] * e1 + g[2] * e2;
+  d.F2 = g[1] * e1 + g[3] * e2;
+  d.c11 = d.F1.squaredNorm(), d.c12 = d.F1.dot(d.F2), d.c22 = d.F2.squaredNorm();
+  return d;
 }
 
 // Thesis eq. 5.6 in the compact form of the file header: f_a = -A0 F S grad N_a with
@@ -129,11 +131,8 @@ void FemMembrane::element_forces(const Law& law, std::span<const Vec<3>> X) cons
   const auto ne = static_cast<std::ptrdiff_t>(triangles_.size());
 #pragma omp parallel for schedule(static) if (ne > parallel_threshold)
   for (std::ptrdiff_t e = 0; e < ne; ++e) {
-    Vec<3> F1, F2;
-    deformation_gradient(static_cast<std::size_t>(e), X, F1, F2);
-    const double c11 = F1.squaredNorm(), c12 = F1.dot(F2), c22 = F2.squaredNorm();
-    const double detC = c11 * c22 - c12 * c12;
-    const auto [W1, W2] = law.derivatives(c11 + c22 - 2.0, detC - 1.0);
+    const auto [F1, F2, c11, c12, c22] = deformation(static_cast<std::size_t>(e), X);
+    const auto [W1, W2] = law.derivatives(c11 + c22 - 2.0, c11 * c22 - c12 * c12 - 1.0);
     const double s11 = 2.0 * (W1 + W2 * c22);
     const double s12 = -2.0 * W2 * c12;
     const double s22 = 2.0 * (W1 + W2 * c11);
@@ -171,10 +170,8 @@ double FemMembrane::energy(std::span<const Vec<3>> X) const {
       [&](const auto& law) {
         double total = 0.0;
         for (std::size_t e = 0; e < triangles_.size(); ++e) {
-          Vec<3> F1, F2;
-          deformation_gradient(e, X, F1, F2);
-          const double c11 = F1.squaredNorm(), c12 = F1.dot(F2), c22 = F2.squaredNorm();
-          total += A0_[e] * law.energy(c11 + c22 - 2.0, c11 * c22 - c12 * c12 - 1.0);
+          const auto d = deformation(e, X);
+          total += A0_[e] * law.energy(d.c11 + d.c22 - 2.0, d.det_c() - 1.0);
         }
         return total;
       },
@@ -187,9 +184,7 @@ void FemMembrane::element_strains(std::span<const Vec<3>> X, std::span<ElementSt
   const auto ne = static_cast<std::ptrdiff_t>(triangles_.size());
 #pragma omp parallel for schedule(static) if (ne > parallel_threshold)
   for (std::ptrdiff_t e = 0; e < ne; ++e) {
-    Vec<3> F1, F2;
-    deformation_gradient(static_cast<std::size_t>(e), X, F1, F2);
-    const double c11 = F1.squaredNorm(), c12 = F1.dot(F2), c22 = F2.squaredNorm();
+    const auto [F1, F2, c11, c12, c22] = deformation(static_cast<std::size_t>(e), X);
     const double detC = std::max(0.0, c11 * c22 - c12 * c12);
     // Eigenvalues of C: the larger from the trace, the smaller as det C / larger (no cancellation).
     const double half_gap = std::sqrt(0.25 * (c11 - c22) * (c11 - c22) + c12 * c12);

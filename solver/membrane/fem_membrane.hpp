@@ -131,8 +131,13 @@ class FemMembrane final : public Membrane<3> {
   const MembraneLaw& law() const { return law_; }
 
  private:
-  // Deformation-gradient columns F = [F1 F2] of element e in configuration X.
-  void deformation_gradient(std::size_t e, std::span<const Vec<3>> X, Vec<3>& F1, Vec<3>& F2) const;
+  // The deformation gradient F = [F1 F2] of element e in configuration X and C = F^T F.
+  struct Deformation {
+    Vec<3> F1, F2;
+    double c11, c12, c22;
+    double det_c() const { return c11 * c22 - c12 * c12; }
+  };
+  Deformation deformation(std::size_t e, std::span<const Vec<3>> X) const;
   // Per-element corner forces into corner_forces_ (the loop of forces(), one instance per law).
   template <class Law>
   void element_forces(const Law& law, std::span<const Vec<3>> X) const;
