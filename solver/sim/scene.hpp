@@ -91,6 +91,9 @@ class Scene {
                         nlohmann::json{{"case_id", spec_.id}});
 
     mass0_ = total_mass();
+    // A snapshot at t = 0 is the initial state (the rest shape of the capsules, the imposed flow).
+    if (snapshots && std::find(snapshot_steps.begin(), snapshot_steps.end(), 0L) != snapshot_steps.end())
+      core::timed(seconds_output_, [&] { write_snapshot(*snapshots, 0.0); });
     auto last_report = clock::now();
     auto hook = [&](const typename FluidT::Pop& pop, typename FluidT::Force& f) { return apply_ib(pop, f); };
     std::vector<double> row(columns_.size());
