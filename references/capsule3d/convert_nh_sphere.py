@@ -148,20 +148,20 @@ def write_steady(rp98: dict) -> list:
             how += f"; over k t >= 4 instead: {late[1]:.6f}, spread {late[2]:.6f} ({late[0]} points)"
         rows.append([f"ramanujan1998_G{ca}", "neo_hookean", ca, "Ramanujan & Pozrikidis 1998 (BIM, digitized)",
                      f"{s['mean']:.6f}", f"{s['spread']:.6f}", "", how])
-    for g in SMALL_DEFORMATION_G:
-        G = float(g)
-        rows.append([f"small_deformation_nh_G{g}", "neo_hookean", g,
-                     "first-order small-deformation theory (Barthes-Biesel 1980; Barthes-Biesel & Rallison 1981)",
-                     repr(25.0 / 4.0 * G), "", repr(math.pi / 4),
-                     "D = (25/4) G = (25/12) eps_Lac with eps_Lac = 3 G (NH, E = 3 G_s); inclination -> pi/4; "
-                     "error O(G^2): valid for small G only (thesis 5.3.1.1: no longer good at G = 0.05)"])
-    for g in SMALL_DEFORMATION_G:
-        G = float(g)
-        rows.append([f"small_deformation_sk_G{g}", "skalak", g,
-                     "first-order small-deformation theory (Barthes-Biesel 1980; Barthes-Biesel & Rallison 1981)",
-                     repr(25.0 / 6.0 * G), "", repr(math.pi / 4),
-                     "D = (25/6) G = (25/12) eps_Lac with eps_Lac = 2 G (Skalak C = 1, E = 2 G_s, surface Poisson "
-                     "ratio C/(1 + C) = 1/2 as NH); inclination -> pi/4; error O(G^2): valid for small G only"])
+    # First-order theory per law: (id prefix, law, D / G, how), in thesis units.
+    theories = [
+        ("small_deformation_nh", "neo_hookean", 25.0 / 4.0,
+         "D = (25/4) G = (25/12) eps_Lac with eps_Lac = 3 G (NH, E = 3 G_s); inclination -> pi/4; "
+         "error O(G^2): valid for small G only (thesis 5.3.1.1: no longer good at G = 0.05)"),
+        ("small_deformation_sk", "skalak", 25.0 / 6.0,
+         "D = (25/6) G = (25/12) eps_Lac with eps_Lac = 2 G (Skalak C = 1, E = 2 G_s, surface Poisson "
+         "ratio C/(1 + C) = 1/2 as NH); inclination -> pi/4; error O(G^2): valid for small G only"),
+    ]
+    for prefix, law, slope, how in theories:
+        for g in SMALL_DEFORMATION_G:
+            rows.append([f"{prefix}_G{g}", law, g,
+                         "first-order small-deformation theory (Barthes-Biesel 1980; Barthes-Biesel & Rallison 1981)",
+                         repr(slope * float(g)), "", repr(math.pi / 4), how])
     header = [
         "Steady Taylor deformation D_xz of an initially spherical capsule in unbounded simple shear (Stokes flow, "
         "viscosity ratio 1), thesis units (G = mu k a / E; NH E = 3 G_s, Skalak E = 2 G_s)",
