@@ -3,6 +3,7 @@
 #   make reproduce-chapterN   one chapter (default fidelity "standard"; FIDELITY=thesis to change)
 #   make reproduce-extra      the external validations that are not thesis cases (catalogue/extra)
 #   make test                 unit + verification + short validation (what CI runs)
+#   make fuzz                 fuzz the case loader (opt-in clang build in build-fuzz; FUZZ_SECONDS=600)
 #   make bench | stress | report | clean
 
 SHELL := /bin/bash
@@ -50,3 +51,25 @@ stress:
 
 clean:
 	rm -rf $(BUILD) $(RESULTS) reports/out
+
+# make fuzz: libFuzzer on the case loader (tests/fuzz/fuzz_case.cpp; clang with ASan and UBSan, its
+# own build directory), seeded with every catalogue case and tests/fuzz/seeds, for FUZZ_SECONDS in
+# one process (one core). Inputs that crash, hang or leak go to tests/fuzz/crashes/ (not in git);
+# replay one with `$(FUZZ_BUILD)/tests/fuzz/fuzz_case FILE`. Opt-in: not part of `make build`.
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 600
+FUZZ_CORPUS ?= $(FUZZ_BUILD)/corpus
+
+.PHONY: fuzz
+fuzz:
+	@CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=Debug -DCAPLAB_FUZZ=ON \
+	  -DCAPLAB_BUILD_TESTS=OFF > /dev/null
+	@cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_case
+	@mkdir -p $(FUZZ_CORPUS) tests/fuzz/crashes
+	@find catalogue -name '*.json' ! -name schema.json | while read -r f; do \
+	  cp -n "$$f" "$(FUZZ_CORPUS)/seed_$$(echo "$$f" | tr / _)"; done
+	@cp -n tests/fuzz/seeds/* tests/fuzz/regressions/* $(FUZZ_CORPUS)/
+	@set -o pipefail; $(FUZZ_BUILD)/tests/fuzz/fuzz_case $(FUZZ_CORPUS) -dict=tests/fuzz/case.dict \
+	  -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=2048 -artifact_prefix=tests/fuzz/crashes/ \
+	  -print_final_stats=1 2>&1 | tee $(FUZZ_BUILD)/fuzz.log | \
+	  grep --line-buffered -E 'pulse|INITED|DONE|ERROR|BUG|SUMMARY|Test unit written|stat::number_of_executed_units|Done [0-9]+ runs'

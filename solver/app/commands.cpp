@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "case/load_case.hpp"
+#include "core/error.hpp"
 #include "sim/run_case.hpp"
 #include "sim/units.hpp"
 
@@ -43,6 +44,11 @@ int check(const CheckArgs& args) {
   print_units(spec, u);
   fmt::print("  steps {} (coarse), node updates {:.3g}, memory {:.1f} MiB\n", u.coarse_steps, u.node_updates,
              u.memory_bytes / (1024.0 * 1024.0));
+  try {
+    sim::check_memory(spec, u, sim::machine_memory_bytes());
+  } catch (const core::InputError& e) {  // the case is valid; it only does not fit on this machine
+    fmt::print("  warning: `caplab run` refuses this case on this machine: {}\n", e.what());
+  }
   fmt::print("  estimated run time: {} at 50 MLUPS, {} at 150 MLUPS\n", human_seconds(u.estimated_seconds(50)),
              human_seconds(u.estimated_seconds(150)));
   fmt::print("ok: {} is valid at fidelity {}\n", args.case_file.string(), spec.fidelity);
@@ -68,20 +74,7 @@ int list(const fs::path& dir) {
 }
 
 int run(const RunArgs& args, bool terminal) {
-  const auto spec = cases::load_case(args.case_file, args.fidelity, args.overrides);
-  auto spec_threads = spec;
-  if (args.threads > 0) spec_threads.numerics.threads = args.threads;
-  fs::path out = args.out;
-  if (out.empty()) {
-    // Same layout as scripts/reproduce: results/<fidelity>/<id with "/" as "__">.
-    std::string id;
-    for (char c : spec.id) id += c == '/' ? std::string("__") : std::string(1, c);
-    out = fs::path("results") / spec.fidelity / id;
-  }
-  const auto units = sim::derive_units(spec_threads);
-  print_units(spec_threads, units);
-  sim::ProgressFn progress = [&](long step, long total, double t, double mlups) {
-    const double eta = (total - step) * (units.node_updates / total) / (mlups * 1e6);
+  sim::ProgressFn progress = [&](long step, long total, double t, double mlups, double eta) {
     const std::string line =
         fmt::format("step {}/{}  t = {:.2f} L/U  {:.1f} MLUPS  ETA {}", step, total, t, mlups, human_seconds(eta));
     if (terminal)
@@ -89,7 +82,28 @@ int run(const RunArgs& args, bool terminal) {
     else if (step % std::max(1L, total / 10) < std::max(1L, total / 200))
       fmt::print(stderr, "{}\n", line);
   };
-  const auto r = sim::run_case(spec_threads, out, progress);
+  const sim::RunOptions options{args.keep_checkpoint};
+  fs::path out = args.out;
+  sim::RunResult r;
+  if (!args.resume.empty()) {
+    out = args.resume;
+    fmt::print("resuming {} from its checkpoint\n", out.string());
+    auto resumed = sim::resume_case(out, args.threads, progress, options);
+    for (const auto& w : resumed.warnings) fmt::print(stderr, "caplab: warning: {}\n", w);
+    r = std::move(resumed.result);
+  } else {
+    const auto spec = cases::load_case(args.case_file, args.fidelity, args.overrides);
+    auto spec_threads = spec;
+    if (args.threads > 0) spec_threads.numerics.threads = args.threads;
+    if (out.empty()) {
+      // Same layout as scripts/reproduce: results/<fidelity>/<id with "/" as "__">.
+      std::string id;
+      for (char c : spec.id) id += c == '/' ? std::string("__") : std::string(1, c);
+      out = fs::path("results") / spec.fidelity / id;
+    }
+    print_units(spec_threads, sim::derive_units(spec_threads));
+    r = sim::run_case(spec_threads, out, progress, options);
+  }
   if (terminal) fmt::print(stderr, "\n");
   fmt::print("ran {} steps in {} ({:.1f} MLUPS) -> {}\n", r.steps, human_seconds(r.wall_seconds), r.mlups, out.string());
   for (const auto& [k, v] : r.summary["metrics"].items()) {

@@ -9,6 +9,8 @@ namespace caplab::app {
 
 struct RunArgs {
   std::filesystem::path case_file, out;
+  std::filesystem::path resume;  ///< continue this interrupted run instead of starting one
+  bool keep_checkpoint = false;
   std::string fidelity = "standard";
   std::vector<std::string> overrides;
   int threads = 0;
@@ -29,6 +31,10 @@ struct ClaimsArgs {
   std::string only;
   bool strict = false;
 };
+struct CompareArgs {
+  std::filesystem::path a, b;
+  double tolerance = 0.0;
+};
 struct BenchArgs {
   std::filesystem::path out;
   bool quick = false;
@@ -40,5 +46,6 @@ int list(const std::filesystem::path& dir);
 int score(const ScoreArgs& args);
 int claims(const ClaimsArgs& args);
 int bench(const BenchArgs& args);
+int compare(const CompareArgs& args);
 
 }  // namespace caplab::app

@@ -1,4 +1,4 @@
-// The `caplab` command: run, check, list, score, claims, bench.
+// The `caplab` command: run, check, list, score, claims, bench, compare.
 //
 // The only place that maps errors to exit codes (DESIGN.md section 6): 0 ran (and, with
 // --strict, passed), 1 scored outside tolerance, 2 bad input, 3 numerical instability,
@@ -27,11 +27,18 @@ int main(int argc, char** argv) {
 
   app::RunArgs run;
   auto* run_cmd = app.add_subcommand("run", "Run a case and write its run directory (then score it)");
-  run_cmd->add_option("case", run.case_file, "Case file (JSON)")->required()->check(CLI::ExistingFile);
-  run_cmd->add_option("--fidelity", run.fidelity, "Fidelity level defined by the case: quick | standard | thesis")
+  auto* run_case = run_cmd->add_option("case", run.case_file, "Case file (JSON)")->check(CLI::ExistingFile);
+  auto* resume = run_cmd->add_option("--resume", run.resume,
+                                     "Continue the interrupted run in this run directory from its checkpoint.h5 "
+                                     "(same case, level and overrides; bit for bit at the same thread count)")
+                     ->check(CLI::ExistingDirectory);
+  run_case->excludes(resume);
+  run_cmd->add_flag("--keep-checkpoint", run.keep_checkpoint, "Keep checkpoint.h5 when the run finishes ok");
+  auto* fidelity = run_cmd->add_option("--fidelity", run.fidelity, "Fidelity level defined by the case: quick | standard | thesis")
       ->default_val("standard");
-  run_cmd->add_option("--out", run.out, "Run directory (default results/<fidelity>/<case id>)");
-  run_cmd->add_option("--set", run.overrides, "Override a case value: path=value (repeatable), e.g. physics.reynolds=200");
+  auto* out = run_cmd->add_option("--out", run.out, "Run directory (default results/<fidelity>/<case id>)");
+  auto* set = run_cmd->add_option("--set", run.overrides, "Override a case value: path=value (repeatable), e.g. physics.reynolds=200");
+  for (auto* o : {fidelity, out, set}) o->excludes(resume);
   run_cmd->add_option("--threads", run.threads, "OpenMP threads (0: all)")->default_val(0);
   run_cmd->add_flag("--strict", run.strict, "Exit 1 when the score fails its tolerances");
 
@@ -69,14 +76,35 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--out", bench.out, "Output directory")->default_val("reports/out/bench");
   bench_cmd->add_flag("--quick", bench.quick, "Small sizes and short timings (smoke test)");
 
-  CLI11_PARSE(app, argc, argv);
+  app::CompareArgs compare;
+  auto* compare_cmd = app.add_subcommand(
+      "compare", "Compare two run directories (series, snapshots, summary): exit 0 when they agree, 1 otherwise");
+  compare_cmd->add_option("run_a", compare.a, "First run directory")->required()->check(CLI::ExistingDirectory);
+  compare_cmd->add_option("run_b", compare.b, "Second run directory")->required()->check(CLI::ExistingDirectory);
+  compare_cmd->add_option("--tolerance", compare.tolerance,
+                          "Largest relative difference accepted (default 0: bit for bit)")
+      ->default_val(0.0)
+      ->check(CLI::NonNegativeNumber);
+
   try {
-    if (*run_cmd) return app::run(run, isatty(fileno(stderr)));
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version exit 0; a bad command line (a missing case file, a directory given
+    // as one, an unknown option) is bad input like a bad case: exit code 2, not CLI11's own.
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  try {
+    if (*run_cmd) {
+      if (run.case_file.empty() && run.resume.empty())
+        throw core::InputError("caplab run needs a case file (caplab run CASE.json) or --resume RUN_DIR");
+      return app::run(run, isatty(fileno(stderr)));
+    }
     if (*check_cmd) return app::check(check);
     if (*list_cmd) return app::list(list_dir);
     if (*score_cmd) return app::score(score);
     if (*claims_cmd) return app::claims(claims);
     if (*bench_cmd) return app::bench(bench);
+    if (*compare_cmd) return app::compare(compare);
   } catch (const core::InputError& e) {
     fmt::print(stderr, "caplab: input error: {}\n", e.what());
     return 2;

@@ -2,6 +2,7 @@
 
 #include "app/commands.hpp"
 #include "bench/bench.hpp"
+#include "io/compare_runs.hpp"
 #include "io/run_directory.hpp"
 #include "score/claims.hpp"
 #include "score/score_run.hpp"
@@ -29,6 +30,19 @@ int bench(const BenchArgs& args) {
   opt.output_dir = args.out;
   bench::run_benchmarks(opt);  // prints its table and writes bench.json
   return 0;
+}
+
+int compare(const CompareArgs& args) {
+  const auto c = io::compare_runs(args.a, args.b, args.tolerance);
+  for (const auto& p : c.problems) fmt::print("  {}\n", p);
+  if (c.identical()) {
+    fmt::print("identical: {} values, bit for bit\n", c.values);
+    return 0;
+  }
+  fmt::print("{}: {} of {} values differ, largest relative difference {:.3g} at {}\n",
+             c.problems.empty() ? "agree within the tolerance" : "differ", c.differing, c.values, c.max_relative,
+             c.worst.empty() ? "-" : c.worst);
+  return c.problems.empty() ? 0 : 1;
 }
 
 }  // namespace caplab::app

@@ -81,9 +81,72 @@ std::string describe(const nlohmann::json& value) {
   // Non-finite numbers only reach here from programmatic documents; nlohmann writes them as null.
   if (value.is_number_float() && !std::isfinite(value.get<double>()))
     return std::to_string(value.get<double>());
-  std::string text = value.is_discarded() ? "nothing" : value.dump();
-  if (text.size() > max_length) text = text.substr(0, max_length - 3) + "...";
+  std::string text =
+      value.is_discarded() ? "nothing" : value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  if (text.size() > max_length) text = printable(text, max_length);
   return text;
+}
+
+namespace {
+
+// Length of the UTF-8 sequence starting at text[i], or 0 when it is ill-formed there.
+std::size_t utf8_sequence(std::string_view text, std::size_t i) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char b = byte(i);
+  if (b < 0x80) return 1;
+  std::size_t n = 0;
+  unsigned char lo = 0x80, hi = 0xBF;  // allowed range of the second byte
+  if (b >= 0xC2 && b <= 0xDF)
+    n = 2;
+  else if (b == 0xE0)
+    n = 3, lo = 0xA0;
+  else if (b == 0xED)
+    n = 3, hi = 0x9F;  // no UTF-16 surrogates
+  else if (b >= 0xE1 && b <= 0xEF)
+    n = 3;
+  else if (b == 0xF0)
+    n = 4, lo = 0x90;
+  else if (b >= 0xF1 && b <= 0xF3)
+    n = 4;
+  else if (b == 0xF4)
+    n = 4, hi = 0x8F;
+  else
+    return 0;
+  if (i + n > text.size()) return 0;
+  if (byte(i + 1) < lo || byte(i + 1) > hi) return 0;
+  for (std::size_t k = 2; k < n; ++k)
+    if (byte(i + k) < 0x80 || byte(i + k) > 0xBF) return 0;
+  return n;
+}
+
+}  // namespace
+
+bool is_utf8(std::string_view text) {
+  for (std::size_t i = 0; i < text.size();) {
+    const std::size_t n = utf8_sequence(text, i);
+    if (n == 0) return false;
+    i += n;
+  }
+  return true;
+}
+
+std::string printable(std::string_view text, std::size_t max_length) {
+  static constexpr char hex[] = "0123456789abcdef";
+  std::string out;
+  std::size_t fits = 0;  // length of `out` up to the last piece that leaves room for "..."
+  for (std::size_t i = 0; i < text.size();) {
+    const std::size_t n = utf8_sequence(text, i);
+    const auto b = static_cast<unsigned char>(text[i]);
+    if (n == 0 || b < 0x20 || b == 0x7F)
+      out += {'\\', 'x', hex[b >> 4], hex[b & 15]};
+    else
+      out.append(text.substr(i, n));
+    i += n == 0 ? 1 : n;
+    if (out.size() + 3 <= max_length) fits = out.size();
+    if (out.size() > max_length) break;
+  }
+  if (out.size() > max_length) out.resize(fits), out += "...";
+  return out;
 }
 
 std::string quoted_list(const std::vector<std::string>& words) {

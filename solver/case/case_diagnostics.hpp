@@ -44,8 +44,17 @@ std::string child_pointer(const std::string& pointer, std::string_view key);
 /// The JSON pointer of element `index` of the array at `pointer`.
 std::string child_pointer(const std::string& pointer, std::size_t index);
 
-/// A short, single-line rendering of a JSON value for messages (long values are cut).
+/// A short, single-line rendering of a JSON value for messages (long values are cut; strings
+/// that are not UTF-8, which only programmatic documents and `--set` text can hold, are shown
+/// with U+FFFD in place of the bad bytes).
 std::string describe(const nlohmann::json& value);
+
+/// `text` made safe for a message: valid UTF-8 kept, every other byte and every control
+/// character written as \xNN, cut to `max_length` bytes (with "...") when longer.
+std::string printable(std::string_view text, std::size_t max_length = 200);
+
+/// True when `text` is well-formed UTF-8 (RFC 3629: no overlong forms, no surrogates).
+bool is_utf8(std::string_view text);
 
 /// `"a", "b", "c"`: the candidates quoted and comma-separated.
 std::string quoted_list(const std::vector<std::string>& words);

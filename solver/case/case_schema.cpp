@@ -138,17 +138,23 @@ SchemaNode build_case_schema() {
                                opt("magic", number(positive))})),  // trt only
       req("precision", choice(enum_names(precision_names))),
       opt("ib",
-          object({opt("kernel", choice(enum_names(kernel_names))), opt("marker_spacing", number(positive)),
-                  opt("forcing_iterations", integer(at_least(1)))})),
+          object({opt("kernel", choice(enum_names(kernel_names))), opt("marker_spacing", number(closed(0.05, 2))),
+                  opt("forcing_iterations", integer(closed(1, 100)))})),
       req("lattice_velocity", number(Range{0, 0.4, true, false})),
       req("end_time", number(positive)),
-      opt("threads", integer(at_least(0))),
+      opt("threads", integer(closed(0, 4096))),
+      opt("guards", object({opt("every", integer(closed(1, 1e9))), opt("max_mach", number(positive)),
+                            opt("max_density_deviation", number(positive)),
+                            opt("max_volume_change", number(positive)),
+                            opt("min_area_ratio", number(Range{0, 1, true, true}))})),
   });
   const SchemaNode outputs = object({
       req("series", object({req("interval", number(positive)), req("quantities", array_of(text()))})),
       opt("snapshots",
-          object({req("times", array_of(number(at_least(0)))), req("fields", array_of(text()))})),
+          object({req("times", array_of(number(at_least(0)))),
+                  req("fields", array_of(choice({"density", "velocity", "vorticity"})))})),  // sim/scene.hpp
       opt("average_from", number(at_least(0))),
+      opt("checkpoint", object({opt("interval", number(at_least(0))), opt("wall_seconds", number(at_least(0)))})),
   });
   // Numeric comparisons need "reference_value" and "tolerance", "mode" needs "reference_mode"
   // instead (a mode name or an array of them): check_acceptance_entries.
@@ -545,9 +551,12 @@ std::string apply_override(json& doc, std::string_view dotted, json value, const
         if (!digits || std::stoul(seg) >= size)
           diag.fail_text(
               at, label,
-              size == 0 ? fmt::format("an index of an existing entry, but the array at {} is empty or absent",
-                                      where)
-                        : fmt::format("an index 0..{} of the array at {} (it has {} entries)", size - 1,
+              !current->is_array() && !current->is_null()
+                  ? fmt::format("an index of an entry of the array at {}, but that is {}, not an array", where,
+                                describe(*current))
+              : size == 0 ? fmt::format("an index of an existing entry, but the array at {} is empty or absent",
+                                        where)
+                          : fmt::format("an index 0..{} of the array at {} (it has {} entries)", size - 1,
                                       where, size));
         child = &node->element.front();
         break;

@@ -133,6 +133,16 @@ struct IbSpec {
 
 enum class Precision { double_, single };
 
+/// The checks every run makes while it goes (sim/scene.hpp check_guards): a run that leaves
+/// these bounds stops with exit code 3 instead of writing garbage.
+struct GuardSpec {
+  int every = 100;                      ///< coarse steps between checks
+  double max_mach = 0.5;                ///< local |u| sqrt(3) in lattice units, any block
+  double max_density_deviation = 0.2;   ///< |rho - 1|
+  double max_volume_change = 0.1;       ///< |V/V0 - 1| of a capsule (2D: enclosed area)
+  double min_area_ratio = 0.05;         ///< smallest element area (2D: segment length) over its rest value
+};
+
 struct NumericsSpec {
   GridSpec grid;
   CollisionSpec collision;
@@ -141,6 +151,7 @@ struct NumericsSpec {
   double lattice_velocity = 0.1;  ///< U in lattice units (same on every block: acoustic scaling)
   double end_time = 1.0;          ///< in L/U
   int threads = 0;                ///< 0: OMP_NUM_THREADS, else the usable processors (CPU quota respected)
+  GuardSpec guards;
 };
 
 struct SeriesSpec {
@@ -153,10 +164,18 @@ struct SnapshotSpec {
   std::vector<std::string> fields;    ///< "vorticity", "velocity", "density"
 };
 
+/// When a run writes checkpoint.h5 (for `caplab run --resume`): every `interval` L/U of
+/// simulated time and every `wall_seconds` of wall time, whichever comes first (0: off).
+struct CheckpointSpec {
+  double interval = 0.0;
+  double wall_seconds = 600.0;
+};
+
 struct OutputSpec {
   SeriesSpec series;
   SnapshotSpec snapshots;
   double average_from = 0.0;  ///< start of the window for means, amplitudes and frequencies (L/U)
+  CheckpointSpec checkpoint;
 };
 
 /// One scored metric (issue "catalogue scoring"); kept typed so scoring and reports share it.
@@ -180,6 +199,8 @@ struct CaseSpec {
   OutputSpec outputs;
   std::vector<AcceptanceSpec> acceptance;
   nlohmann::json resolved;  ///< the fully resolved JSON (fidelity and overrides applied)
+  nlohmann::json document;  ///< the case as read, before the level and the overrides (a resumed run reloads it)
+  std::vector<std::string> overrides;  ///< the --set overrides, in order
 };
 
 }  // namespace caplab::cases

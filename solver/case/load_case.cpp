@@ -25,52 +25,66 @@ using nlohmann::json;
 // ---- Reading. ----
 
 // Tracks where the parser is, to name the place of a repeated key (nlohmann keeps the last one
-// silently, which would hide a typo'd copy-paste).
-class DuplicateKeyGuard {
- public:
-  explicit DuplicateKeyGuard(std::string file) : file_(std::move(file)) {}
-
-  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start:
-        frames_.push_back({false, "", 0, {}});
-        break;
-      case json::parse_event_t::array_start:
-        frames_.push_back({true, "", 0, {}});
-        break;
-      case json::parse_event_t::key: {
-        Frame& top = frames_.back();
-        top.key = parsed.get<std::string>();
-        if (!top.seen.insert(top.key).second)
-          throw core::InputError(file_, pointer(), "the key \"" + top.key + "\" a second time in one object",
-                                 "each key at most once per object");
-        break;
-      }
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        frames_.pop_back();
-        [[fallthrough]];
-      case json::parse_event_t::value:
-        if (!frames_.empty() && frames_.back().is_array) ++frames_.back().index;
-        break;
-    }
-    return true;
-  }
-
- private:
+// silently, which would hide a typo'd copy-paste) and of a syntax error, and bounds the nesting
+// depth (copying, comparing and printing JSON values recurse: garbage nested a million levels
+// deep would overflow the stack long after parsing). The parser copies its callback, so the
+// frames live outside it, in a ParsePosition.
+struct ParsePosition {
   struct Frame {
     bool is_array;
     std::string key;
     std::size_t index;
     std::set<std::string> seen;
   };
+  std::vector<Frame> frames;
+
+  /// The JSON pointer of the value being read ("" at the top level).
   std::string pointer() const {
     std::string p;
-    for (const auto& f : frames_) p = f.is_array ? child_pointer(p, f.index) : child_pointer(p, f.key);
+    for (const auto& f : frames) p = f.is_array ? child_pointer(p, f.index) : child_pointer(p, f.key);
     return p;
   }
+};
+
+class DuplicateKeyGuard {
+ public:
+  DuplicateKeyGuard(std::string file, ParsePosition& position) : file_(std::move(file)), at_(&position) {}
+
+  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+    auto& frames = at_->frames;
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        if (frames.size() >= max_case_nesting)
+          throw core::InputError(
+              file_, at_->pointer(),
+              fmt::format("arrays and objects nested more than {} deep", max_case_nesting),
+              fmt::format("at most {} levels of nesting (a case needs about 8)", max_case_nesting));
+        frames.push_back({event == json::parse_event_t::array_start, "", 0, {}});
+        break;
+      case json::parse_event_t::key: {
+        auto& top = frames.back();
+        top.key = parsed.get<std::string>();
+        if (!top.seen.insert(top.key).second)
+          throw core::InputError(file_, at_->pointer(),
+                                 "the key \"" + top.key + "\" a second time in one object",
+                                 "each key at most once per object");
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        frames.pop_back();
+        [[fallthrough]];
+      case json::parse_event_t::value:
+        if (!frames.empty() && frames.back().is_array) ++frames.back().index;
+        break;
+    }
+    return true;
+  }
+
+ private:
   std::string file_;
-  std::vector<Frame> frames_;
+  ParsePosition* at_;
 };
 
 // nlohmann prefixes its messages with "[json.exception.parse_error.101] "; users need the rest.
@@ -79,7 +93,25 @@ std::string without_exception_id(const std::string& what) {
   return what.rfind("[json.exception.", 0) == 0 && close != std::string::npos ? what.substr(close + 2) : what;
 }
 
+// The word of `text` around byte `byte` (1-based, as nlohmann counts: the last byte it read),
+// up to the JSON delimiters on either side: "NaN", "Infinity", "01", "0x10" as written.
+std::string token_at(std::string_view text, std::size_t byte) {
+  constexpr std::string_view delimiters = " \t\r\n,:[]{}\"";
+  if (byte == 0 || byte > text.size()) return "";
+  std::size_t i = byte - 1;
+  if (delimiters.find(text[i]) != std::string_view::npos) {
+    if (i == 0 || delimiters.find(text[i - 1]) != std::string_view::npos) return "";
+    --i;
+  }
+  std::size_t begin = i, end = i + 1;
+  while (begin > 0 && delimiters.find(text[begin - 1]) == std::string_view::npos && i - begin < 40) --begin;
+  while (end < text.size() && delimiters.find(text[end]) == std::string_view::npos && end - i < 40) ++end;
+  return std::string(text.substr(begin, end - begin));
+}
+
 // ---- Fidelity levels and overrides. ----
+
+constexpr std::size_t max_fidelity_levels = 16;
 
 // The fidelity levels of `doc`, after checking the "fidelity" object itself.
 std::vector<std::string> checked_levels(const json& doc, const CaseDiagnostics& diag) {
@@ -91,6 +123,12 @@ std::vector<std::string> checked_levels(const json& doc, const CaseDiagnostics& 
   check_against(member.node, doc.at("fidelity"), "/fidelity", diag, unused);
   std::vector<std::string> levels;
   for (const auto& item : doc.at("fidelity").items()) levels.push_back(item.key());
+  // Each level is applied to a copy of the document to check its paths: bound the copies.
+  if (levels.size() > max_fidelity_levels)
+    diag.fail_text(
+        "/fidelity", fmt::format("{} fidelity levels", levels.size()),
+        fmt::format("at most {} levels (the catalogue defines \"quick\", \"standard\" and \"thesis\")",
+                    max_fidelity_levels));
   return levels;
 }
 
@@ -108,16 +146,26 @@ void apply_level(json& target, const json& doc, const std::string& level, CaseDi
 
 // Applies one "--set path=value" override; the value is JSON if it parses, else a string.
 void apply_set(json& target, const std::string& text, CaseDiagnostics& diag) {
-  const std::string label = "--set " + text;
+  const std::string label = "--set " + printable(text);
+  if (!is_utf8(text))
+    diag.fail_text("", label, "an override written in UTF-8 (the bytes shown as \\xNN are not)");
   const std::size_t eq = text.find('=');
-  if (eq == std::string::npos || eq == 0)
+  std::string path = text.substr(0, eq == std::string::npos ? 0 : eq);
+  const std::size_t first = path.find_first_not_of(" \t"), last = path.find_last_not_of(" \t");
+  path = first == std::string::npos ? std::string() : path.substr(first, last - first + 1);
+  if (eq == std::string::npos || path.empty())
     diag.fail_text("", label, "an override of the form path=value, e.g. physics.reynolds=200");
-  std::string path = text.substr(0, eq);
-  path.erase(path.find_last_not_of(" \t") + 1);
-  path.erase(0, path.find_first_not_of(" \t"));
   const std::string raw = text.substr(eq + 1);
-  json value = json::parse(raw, nullptr, /*allow_exceptions=*/false);
-  if (value.is_discarded()) value = raw;
+  json value;
+  try {
+    ParsePosition position;
+    value = json::parse(raw, DuplicateKeyGuard(diag.source(), position));
+  } catch (const json::exception&) {
+    value = raw;                         // not JSON: the text is a string value
+  } catch (const core::InputError& e) {  // a repeated key or runaway nesting inside the value
+    diag.fail_text("", fmt::format("{} ({} at {} of the value)", label, e.value(), e.json_path()),
+                   e.expected());
+  }
   const std::string written = apply_override(target, path, std::move(value), label, "", diag);
   diag.note_origin(written, label);
 }
@@ -237,6 +285,13 @@ CaseSpec to_spec(const json& doc, const CaseDiagnostics& diag) {
   numerics.lattice_velocity = n.at("lattice_velocity").get<double>();
   numerics.end_time = n.at("end_time").get<double>();
   numerics.threads = n.value("threads", numerics.threads);
+  const json guards = n.value("guards", json::object());
+  auto& g = numerics.guards;
+  g.every = guards.value("every", g.every);
+  g.max_mach = guards.value("max_mach", g.max_mach);
+  g.max_density_deviation = guards.value("max_density_deviation", g.max_density_deviation);
+  g.max_volume_change = guards.value("max_volume_change", g.max_volume_change);
+  g.min_area_ratio = guards.value("min_area_ratio", g.min_area_ratio);
 
   const json& o = doc.at("outputs");
   spec.outputs.series.interval = o.at("series").at("interval").get<double>();
@@ -246,6 +301,9 @@ CaseSpec to_spec(const json& doc, const CaseDiagnostics& diag) {
     spec.outputs.snapshots.fields = o.at("snapshots").at("fields").get<std::vector<std::string>>();
   }
   spec.outputs.average_from = o.value("average_from", spec.outputs.average_from);
+  const json checkpoint = o.value("checkpoint", json::object());
+  spec.outputs.checkpoint.interval = checkpoint.value("interval", spec.outputs.checkpoint.interval);
+  spec.outputs.checkpoint.wall_seconds = checkpoint.value("wall_seconds", spec.outputs.checkpoint.wall_seconds);
 
   for (const auto& a : doc.value("acceptance", json::array())) {
     AcceptanceSpec entry;
@@ -287,6 +345,12 @@ void complete(CaseSpec& spec, json& resolved) {
                                 {"marker_spacing", numerics.ib.marker_spacing},
                                 {"forcing_iterations", numerics.ib.forcing_iterations}};
   resolved["numerics"]["threads"] = numerics.threads;
+  const GuardSpec& g = numerics.guards;
+  resolved["numerics"]["guards"] = {{"every", g.every},
+                                    {"max_mach", g.max_mach},
+                                    {"max_density_deviation", g.max_density_deviation},
+                                    {"max_volume_change", g.max_volume_change},
+                                    {"min_area_ratio", g.min_area_ratio}};
   for (std::size_t i = 0; i < spec.physics.bodies.size(); ++i) {
     const BodySpec& body = spec.physics.bodies[i];
     json& b = resolved["physics"]["bodies"][i];
@@ -303,6 +367,8 @@ void complete(CaseSpec& spec, json& resolved) {
   resolved["outputs"]["snapshots"] = {{"times", spec.outputs.snapshots.times},
                                       {"fields", spec.outputs.snapshots.fields}};
   resolved["outputs"]["average_from"] = spec.outputs.average_from;
+  resolved["outputs"]["checkpoint"] = {{"interval", spec.outputs.checkpoint.interval},
+                                       {"wall_seconds", spec.outputs.checkpoint.wall_seconds}};
   if (!resolved.contains("acceptance")) resolved["acceptance"] = json::array();
   spec.resolved = std::move(resolved);
 }
@@ -315,14 +381,35 @@ json read_case_json(const std::filesystem::path& file) {
     throw core::InputError(
         fmt::format("{}: cannot read the case file: {}", file.string(),
                     std::filesystem::exists(file, ec) ? "not a regular file" : "no such file"));
+  const auto bytes = std::filesystem::file_size(file, ec);
+  if (!ec && bytes > max_case_file_bytes)
+    throw core::InputError(
+        fmt::format("{}: cannot read the case file: it has {} bytes, more than the {} MiB a case "
+                    "file may have; is it a case file?",
+                    file.string(), bytes, max_case_file_bytes >> 20));
   std::ifstream in(file, std::ios::binary);
   if (!in) throw core::InputError(fmt::format("{}: cannot open the case file for reading", file.string()));
   const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad())
+    throw core::InputError(fmt::format("{}: cannot read the case file: read error", file.string()));
+  return parse_case_text(text, file.string());
+}
+
+json parse_case_text(std::string_view text, const std::string& source_name) {
+  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
+    throw core::InputError(fmt::format("{}: malformed JSON: the case file is {}; expected a JSON object",
+                                       source_name, text.empty() ? "empty" : "blank"));
+  ParsePosition position;
   try {
-    return json::parse(text, DuplicateKeyGuard(file.string()));
+    return json::parse(text, DuplicateKeyGuard(source_name, position));
   } catch (const json::exception& e) {  // parse_error carries line and column in its message
-    throw core::InputError(
-        fmt::format("{}: malformed JSON: {}", file.string(), without_exception_id(e.what())));
+    const std::string at = position.pointer();
+    const auto* parse_error = dynamic_cast<const json::parse_error*>(&e);
+    const std::string token = parse_error ? token_at(text, parse_error->byte) : "";
+    throw core::InputError(fmt::format("{}: malformed JSON{}{}: {}", source_name,
+                                       at.empty() ? " near / (the top level)" : " near " + at,
+                                       token.empty() ? "" : " at `" + printable(token, 40) + "`",
+                                       printable(without_exception_id(e.what()))));
   }
 }
 
@@ -336,14 +423,7 @@ CaseSpec parse_case(const json& doc, const std::string& source_name, const std::
         "a level this case defines: " + (levels.empty() ? std::string("(none)") : quoted_list(levels)) +
             did_you_mean(fidelity, levels));
 
-  // Every level's paths must exist, even those not applied now, so that a typo in "thesis"
-  // is found by a "quick" run.
   json resolved = doc;
-  for (const auto& level : levels) {
-    if (level == fidelity) continue;
-    json scratch = doc;
-    apply_level(scratch, doc, level, diag, false);
-  }
   apply_level(resolved, doc, fidelity, diag, true);
   for (const auto& text : overrides) apply_set(resolved, text, diag);
 
@@ -351,10 +431,20 @@ CaseSpec parse_case(const json& doc, const std::string& source_name, const std::
   check_against(case_schema(), resolved, "", diag, per_axis);
   check_conditional_keys(resolved, diag);
   check_axis_lengths(resolved, resolved.at("physics").at("dimension").get<int>(), per_axis, diag);
+  // Every level's paths must exist, even those not applied now, so that a typo in "thesis"
+  // is found by a "quick" run (after the case itself is checked: a key missing from the case
+  // is reported as missing, not as a path of another level that leads nowhere).
+  for (const auto& level : levels) {
+    if (level == fidelity) continue;
+    json scratch = doc;
+    apply_level(scratch, doc, level, diag, false);
+  }
 
   CaseSpec spec = to_spec(resolved, diag);
   spec.source_file = source_name;
   spec.fidelity = fidelity;
+  spec.document = doc;
+  spec.overrides = overrides;
   check_consistency(spec, levels, diag);
   complete(spec, resolved);
   return spec;
@@ -363,6 +453,11 @@ CaseSpec parse_case(const json& doc, const std::string& source_name, const std::
 CaseSpec load_case(const std::filesystem::path& file, const std::string& fidelity,
                    const std::vector<std::string>& overrides) {
   return parse_case(read_case_json(file), file.string(), fidelity, overrides);
+}
+
+CaseSpec load_case_text(std::string_view text, const std::string& source_name, const std::string& fidelity,
+                        const std::vector<std::string>& overrides) {
+  return parse_case(parse_case_text(text, source_name), source_name, fidelity, overrides);
 }
 
 std::vector<std::string> fidelity_levels(const json& doc, const std::string& source_name) {

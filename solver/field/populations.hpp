@@ -10,6 +10,9 @@
 // Population i of node n is at [i · grid.size() + n].
 #pragma once
 
+#include <span>
+#include <string>
+
 #include "field/grid.hpp"
 
 namespace caplab::field {
@@ -37,6 +40,14 @@ class Populations {
   /// Shifted population i of linear node n in the current buffer.
   T& operator()(int i, std::ptrdiff_t n) { return buf_[cur_][i * grid_.size() + n]; }
   T operator()(int i, std::ptrdiff_t n) const { return buf_[cur_][i * grid_.size() + n]; }
+
+  /// Both buffers and which one is current (io/checkpoint.hpp archive).
+  template <class Archive>
+  void checkpoint(Archive& ar, const std::string& prefix) {
+    ar(prefix + "pop_a", std::span<T>(buf_[0]));
+    ar(prefix + "pop_b", std::span<T>(buf_[1]));
+    ar(prefix + "current", cur_);
+  }
 
   /// Bytes one node update moves in the fused kernel (read Q, write Q values).
   static constexpr std::size_t bytes_per_update() { return 2 * Q * sizeof(T); }

@@ -144,6 +144,43 @@ RunDirectory RunDirectory::create(const fs::path& out, bool overwrite) {
   return run;
 }
 
+void RunDirectory::check_resumable(const fs::path& dir) {
+  const auto m = read_manifest(dir);
+  if (!m || !m->is_object())
+    throw core::InputError("'" + dir.string() + "' is not a caplab run directory (no readable manifest.json); "
+                           "--resume takes the --out directory of an interrupted run");
+  const std::string status = m->value("status", std::string("running"));
+  if (status == "ok")
+    throw core::InputError("the run in '" + dir.string() + "' finished ok; there is nothing to resume");
+  if (status == "diverged")
+    throw core::InputError("the run in '" + dir.string() +
+                           "' stopped at a numerical instability (see the error in its manifest.json): resumed as is "
+                           "it would diverge again; change the case as the message suggests and run it afresh");
+  if (status == "input_error")
+    throw core::InputError("the run in '" + dir.string() + "' was refused for its input; fix the case and run it afresh");
+  std::error_code ec;
+  if (!fs::is_regular_file(dir / "checkpoint.h5", ec))
+    throw core::InputError("the run in '" + dir.string() +
+                           "' stopped before it wrote a checkpoint (checkpoint.h5); run it afresh (outputs.checkpoint "
+                           "sets how often a run writes one)");
+}
+
+RunDirectory RunDirectory::resume(const fs::path& dir) {
+  check_resumable(dir);
+  const auto m = read_manifest(dir);
+  const std::string status = m->value("status", std::string("running"));
+  RunDirectory run(dir);
+  run.manifest_ = *m;
+  run.manifest_["status"] = "running";
+  nlohmann::json entry = {{"at_utc", utc_now_iso8601()}, {"status_before", status}};
+  if (run.manifest_.contains("error")) entry["error_before"] = run.manifest_["error"];
+  run.manifest_.erase("finished_utc");
+  run.manifest_.erase("error");
+  run.manifest_["resumed"].push_back(entry);
+  run.write_manifest();
+  return run;
+}
+
 fs::path RunDirectory::path(const std::string& name) const {
   check_plain_name(name);
   return root_ / name;

@@ -38,6 +38,14 @@ class RunDirectory {
   /// Refusals throw core::InputError naming the path and the fix.
   static RunDirectory create(const std::filesystem::path& out, bool overwrite);
 
+  /// Reopens the directory of an interrupted run to continue it from its checkpoint.h5
+  /// (`caplab run --resume`): the manifest says "running" again and lists the resume under
+  /// "resumed". Only a run that was killed (status "running") or failed for a reason other
+  /// than its input or numerics ("failed") can be resumed; anything else, or a directory
+  /// without checkpoint.h5, is refused with a core::InputError that says why and what to do.
+  static RunDirectory resume(const std::filesystem::path& dir);
+  /// The checks of resume() without changing anything.
+  static void check_resumable(const std::filesystem::path& dir);
   /// Status of the run in `dir`: the manifest's final status (ok | input_error | diverged |
   /// failed), "missing" when there is no manifest.json, "incomplete" when the manifest says
   /// "running", has no status, or cannot be parsed.

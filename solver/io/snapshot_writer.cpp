@@ -152,6 +152,47 @@ SnapshotWriter<D>::SnapshotWriter(fs::path h5_file, fs::path xdmf_file, std::str
 }
 
 template <int D>
+SnapshotWriter<D> SnapshotWriter<D>::reopen(fs::path h5_file, fs::path xdmf_file, std::string h5_href,
+                                            const nlohmann::json& index) {
+  SnapshotWriter<D> w;
+  Impl& m = *w.impl_;
+  m.h5_path = std::move(h5_file);
+  m.xdmf_path = std::move(xdmf_file);
+  m.href = xml_escape(h5_href.empty() ? m.h5_path.filename().string() : h5_href);
+  for (const auto& s : index)
+    m.steps.push_back(Step{s.at("time").get<double>(), s.at("group").get<std::string>(),
+                           s.at("grids_xml").get<std::vector<std::string>>(),
+                           s.at("names").get<std::set<std::string>>()});
+  detail::translate_h5_errors("reopening the snapshot file", m.h5_path, [&] {
+    m.h5.emplace(m.h5_path.string(), H5F_ACC_RDWR);
+    // Steps written after the index (by the interrupted process) are written again.
+    for (std::size_t k = m.steps.size();; ++k) {
+      const std::string group = fmt::format("step_{:06d}", k);
+      if (!m.h5->nameExists(group)) break;
+      m.h5->unlink(group);
+    }
+    for (const Step& s : m.steps)
+      if (!m.h5->nameExists(s.group))
+        throw core::Error("io: the snapshot file '" + m.h5_path.string() + "' lacks the step '" + s.group +
+                          "' that the checkpoint lists");
+  });
+  m.open = true;
+  m.publish();
+  return w;
+}
+
+template <int D>
+nlohmann::json SnapshotWriter<D>::index() const {
+  nlohmann::json steps = nlohmann::json::array();
+  for (const Step& s : impl_->steps)
+    steps.push_back({{"time", s.time}, {"group", s.group}, {"grids_xml", s.grids_xml}, {"names", s.names}});
+  return steps;
+}
+
+template <int D>
+SnapshotWriter<D>::SnapshotWriter() : impl_(std::make_unique<Impl>()) {}
+
+template <int D>
 SnapshotWriter<D>::~SnapshotWriter() {
   if (!impl_) return;
   try {

@@ -56,6 +56,13 @@ class SnapshotWriter {
   /// attributes of the root group.
   SnapshotWriter(std::filesystem::path h5_file, std::filesystem::path xdmf_file, std::string h5_href = {},
                  const nlohmann::json& attributes = nlohmann::json::object());
+  /// Reopens `h5_file`, written by a writer whose index() was `index`, to continue it (a
+  /// resumed run): steps written after that index are removed and the XDMF rewritten. Throws
+  /// core::Error when the file cannot be opened or lacks a step of the index.
+  static SnapshotWriter reopen(std::filesystem::path h5_file, std::filesystem::path xdmf_file, std::string h5_href,
+                               const nlohmann::json& index);
+  /// The steps written so far (their times, groups and XDMF grids), for a checkpoint.
+  nlohmann::json index() const;
   /// Closes the file if close() was not called; errors are swallowed here, so call close().
   ~SnapshotWriter();
   SnapshotWriter(SnapshotWriter&&) noexcept;
@@ -88,6 +95,7 @@ class SnapshotWriter {
   const std::filesystem::path& xdmf_file() const;
 
  private:
+  SnapshotWriter();
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

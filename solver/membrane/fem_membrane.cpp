@@ -194,15 +194,31 @@ void FemMembrane::element_strains(std::span<const Vec<3>> X, std::span<ElementSt
   }
 }
 
-double FemMembrane::min_area_ratio(std::span<const Vec<3>> X) const {
+ElementHealth<3> FemMembrane::health(std::span<const Vec<3>> X) const {
   check_size("X", X.size(), node_count());
-  double J = std::numeric_limits<double>::infinity();
+  ElementHealth<3> h;
+  h.min_ratio = std::numeric_limits<double>::infinity();
+  h.max_ratio = 0;
+  std::vector<Vec<3>> normal(triangles_.size()), around(node_count(), Vec<3>::Zero());
   for (std::size_t e = 0; e < triangles_.size(); ++e) {
     const auto& t = triangles_[e];
-    const double area = 0.5 * (X[t[1]] - X[t[0]]).cross(X[t[2]] - X[t[0]]).norm();
-    J = std::min(J, area / A0_[e]);
+    normal[e] = 0.5 * (X[t[1]] - X[t[0]]).cross(X[t[2]] - X[t[0]]);  // area-weighted
+    const double J = normal[e].norm() / A0_[e];
+    if (J < h.min_ratio) h.min_ratio = J, h.worst = e;
+    h.max_ratio = std::max(h.max_ratio, J);
+    for (const int n : t) around[n] += normal[e];
   }
-  return J;
+  for (std::size_t e = 0; e < triangles_.size() && h.folded < 0; ++e) {
+    const auto& t = triangles_[e];
+    if (normal[e].dot(around[t[0]] + around[t[1]] + around[t[2]]) < 0) h.folded = static_cast<long>(e);
+  }
+  auto centre = [&](std::size_t e) {
+    const auto& t = triangles_[e];
+    return Vec<3>((X[t[0]] + X[t[1]] + X[t[2]]) / 3.0);
+  };
+  h.worst_at = centre(h.worst);
+  if (h.folded >= 0) h.folded_at = centre(static_cast<std::size_t>(h.folded));
+  return h;
 }
 
 }  // namespace caplab::membrane

@@ -121,7 +121,11 @@ class FemMembrane final : public Membrane<3> {
 
   /// Smallest area ratio J = A/A0 = sqrt(det C) over the elements; J -> 0 is a collapsing element
   /// (J cannot be negative for a surface triangle; see the file header).
-  double min_area_ratio(std::span<const Vec<3>> X) const;
+  double min_area_ratio(std::span<const Vec<3>> X) const { return health(X).min_ratio; }
+
+  /// The smallest J and its element; an element is folded (inverted) when its normal points
+  /// against the summed normals of the triangles around its three nodes.
+  ElementHealth<3> health(std::span<const Vec<3>> X) const override;
 
   /// The rest mesh's triangles (outward orientation as given).
   const std::vector<std::array<int, 3>>& triangles() const { return triangles_; }

@@ -14,6 +14,20 @@
 
 namespace caplab::membrane {
 
+/// The worst element of a configuration (for the guards of a run): the smallest ratio of an
+/// element's size to its rest size (3D: triangle area A/A0 = J; 2D: segment length l/l0), the
+/// element where it occurs (index and centre), and the first element folded over its
+/// neighbours (-1: none).
+template <int D>
+struct ElementHealth {
+  double min_ratio = 1.0;
+  std::size_t worst = 0;
+  Vec<D> worst_at = Vec<D>::Zero();
+  double max_ratio = 1.0;  ///< the largest ratio (an over-stretched or exploding element)
+  long folded = -1;
+  Vec<D> folded_at = Vec<D>::Zero();
+};
+
 template <int D>
 class Membrane {
  public:
@@ -28,6 +42,9 @@ class Membrane {
 
   /// Elastic + bending energy of configuration X (for tests and diagnostics).
   virtual double energy(std::span<const Vec<D>> X) const = 0;
+
+  /// The worst element of configuration X (see ElementHealth).
+  virtual ElementHealth<D> health(std::span<const Vec<D>> X) const = 0;
 };
 
 }  // namespace caplab::membrane

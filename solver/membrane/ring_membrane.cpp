@@ -1,6 +1,7 @@
 #include "membrane/ring_membrane.hpp"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -142,6 +143,27 @@ double RingMembrane::energy(std::span<const Vec<2>> X) const {
     bend += 0.5 * E_B_ * dk * dk * 0.5 * (l_[prev] + l_[i]);
   }
   return hooke + bend;
+}
+
+ElementHealth<2> RingMembrane::health(std::span<const Vec<2>> X) const {
+  check_size("X", X.size());
+  const std::size_t n = X.size();
+  segments(X, l_, t_);
+  ElementHealth<2> h;
+  h.min_ratio = std::numeric_limits<double>::infinity();
+  h.max_ratio = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double ratio = l_[i] / rest_lengths_[i];
+    if (ratio < h.min_ratio) h.min_ratio = ratio, h.worst = i;
+    h.max_ratio = std::max(h.max_ratio, ratio);
+    const Vec<2>& before = t_[i == 0 ? n - 1 : i - 1];
+    const Vec<2>& after = t_[i + 1 == n ? 0 : i + 1];
+    if (h.folded < 0 && t_[i].dot(before) < 0 && t_[i].dot(after) < 0) h.folded = static_cast<long>(i);
+  }
+  auto centre = [&](std::size_t i) { return Vec<2>(0.5 * (X[i] + X[i + 1 == n ? 0 : i + 1])); };
+  h.worst_at = centre(h.worst);
+  if (h.folded >= 0) h.folded_at = centre(static_cast<std::size_t>(h.folded));
+  return h;
 }
 
 }  // namespace caplab::membrane

@@ -64,6 +64,10 @@ class RingMembrane final : public Membrane<2> {
   /// Hooke + bending energy (see the file header). X has node_count() entries (checked).
   double energy(std::span<const Vec<2>> X) const override;
 
+  /// The shortest segment relative to its rest length; a segment is folded when it points
+  /// against both of its neighbours.
+  ElementHealth<2> health(std::span<const Vec<2>> X) const override;
+
   /// Rest segment lengths l0_i (segment i joins node i to node i+1).
   std::span<const double> rest_lengths() const { return rest_lengths_; }
   /// Reference curvature kappa0_i at each node.

@@ -126,6 +126,14 @@ class TwoLevel {
     }
   }
 
+  /// The coarse history the ghosts interpolate in time (io/checkpoint.hpp archive).
+  template <class Archive>
+  void checkpoint(Archive& ar, const std::string& prefix) {
+    ar(prefix + "history", std::span<T>(history_));
+    ar(prefix + "newest", newest_);
+    ar(prefix + "primed", primed_);
+  }
+
   /// Number of fine ghost nodes (surface size of the coupling).
   std::size_t ghost_count() const { return ghosts_.size(); }
   /// Whether a coarse node lies strictly inside the fine block (its value comes from the fine grid).

@@ -97,6 +97,13 @@ class Capsule {
         transfer_);
   }
 
+  /// The node positions (io/checkpoint.hpp archive); forces and velocities are recomputed
+  /// by the next step before anything reads them.
+  template <class Archive>
+  void checkpoint(Archive& ar, const std::string& prefix) {
+    ar(prefix + "X", std::span<double>(X_.data()->data(), X_.size() * D));
+  }
+
   /// Steps 3 and 4: interpolates velocity_at(const Index<D>&, std::ptrdiff_t) -> Vec<D>
   /// (lattice units, safe to call concurrently) at the nodes and moves them by one time step
   /// of the block of spacing `dx` (in L): X += U dx.

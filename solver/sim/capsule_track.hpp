@@ -45,6 +45,17 @@ class CapsuleTrack;
 /// Below this Taylor parameter an initially round capsule has no axis worth following.
 inline constexpr double round_capsule_taylor = 1e-4;
 
+/// The inclination and the tracked node's phase, kept continuous in time; their history is the
+/// only state of a track that a restart must restore (the shape is recomputed every step).
+struct TrackAngles {
+  diagnostics::AngleUnwrapper inclination{std::numbers::pi}, phase{2 * std::numbers::pi};
+  template <class Archive>
+  void checkpoint(Archive& ar, const std::string& prefix) {
+    inclination.checkpoint(ar, prefix + "inclination/");
+    phase.checkpoint(ar, prefix + "phase/");
+  }
+};
+
 template <>
 class CapsuleTrack<2> {
  public:
@@ -71,20 +82,27 @@ class CapsuleTrack<2> {
     const auto X = c.positions();
     shape_ = diagnostics::equivalent_ellipse(X);
     // An initially circular capsule starts at D = 0: follow its axis only once there is one.
-    if (shape_.taylor < round_capsule_taylor) inclination_.reset();
-    theta_ = inclination_(shape_.inclination);
+    if (shape_.taylor < round_capsule_taylor) angles_.inclination.reset();
+    theta_ = angles_.inclination(shape_.inclination);
     const Vec<2> r = X[0] - shape_.centroid;
-    phi_ = phase_(std::atan2(r[1], r[0]));
+    phi_ = angles_.phase(std::atan2(r[1], r[0]));
   }
 
   /// `velocity_lu`: the reference velocity k a in lattice units (node velocities are lattice units).
   double value(std::string_view q, const Capsule<2>& c, double velocity_lu) const {
     if (q == "taylor_deformation") return shape_.taylor;
     if (q == "inclination") return theta_;
-    if (q == "area_change") return shape_.area / area0_ - 1.0;
+    if (q == "area_change") return volume_change();
     if (q == "tank_treading_period") return tank_treading_period(c, velocity_lu);
     return phi_;
   }
+
+  /// Enclosed area over its initial value, minus 1 (the 2D volume, for the guards).
+  double volume_change() const { return shape_.area / area0_ - 1.0; }
+
+  /// The unwrapping history (io/checkpoint.hpp archive); the shape is recomputed every step.
+  template <class Archive>
+  void checkpoint(Archive& ar, const std::string& prefix) { angles_.checkpoint(ar, prefix); }
 
   void add_to_snapshot(io::SnapshotWriter<2>& w, double t, const Capsule<2>& c) const {
     const auto segs = io::closed_ring_segments(static_cast<int>(c.positions().size()));
@@ -110,7 +128,7 @@ class CapsuleTrack<2> {
 
   double area0_;
   diagnostics::EquivalentEllipse shape_;
-  diagnostics::AngleUnwrapper inclination_{std::numbers::pi}, phase_{2 * std::numbers::pi};
+  TrackAngles angles_;
   double theta_ = 0.0, phi_ = 0.0;
 };
 
@@ -148,17 +166,17 @@ class CapsuleTrack<3> {
   void update(const Capsule<3>& c) {
     const auto X = c.positions();
     shape_ = diagnostics::equivalent_ellipsoid(X, fem_->triangles());
-    if (shape_.taylor_xz < round_capsule_taylor) inclination_.reset();
-    theta_ = inclination_(shape_.inclination);
+    if (shape_.taylor_xz < round_capsule_taylor) angles_.inclination.reset();
+    theta_ = angles_.inclination(shape_.inclination);
     const Vec<3> r = X[tracked_] - shape_.center;
-    phi_ = phase_(std::atan2(r[2], r[0]));
+    phi_ = angles_.phase(std::atan2(r[2], r[0]));
   }
 
   double value(std::string_view q, const Capsule<3>& c, double /*velocity_lu*/) const {
     if (q == "taylor_deformation") return shape_.taylor_xz;
     if (q == "inclination") return theta_;
     if (q == "length" || q == "width" || q == "thickness") return semi_axis(q);
-    if (q == "volume_change") return shape_.volume / volume0_ - 1.0;
+    if (q == "volume_change") return volume_change();
     if (q == "surface_area_change") return geometry::surface_area(c.positions(), fem_->triangles()) / area0_ - 1.0;
     if (q == "max_area_change")
       return diagnostics::max_area_change(c.positions(), fem_->triangles(), fem_->reference_areas());
@@ -167,6 +185,12 @@ class CapsuleTrack<3> {
 
   /// The surface with, per node, the mean over its triangles of the largest principal stretch
   /// and of the local area ratio J = lambda1 lambda2 (ParaView colours the membrane by them).
+  /// Enclosed volume over its initial value, minus 1.
+  double volume_change() const { return shape_.volume / volume0_ - 1.0; }
+
+  template <class Archive>
+  void checkpoint(Archive& ar, const std::string& prefix) { angles_.checkpoint(ar, prefix); }
+
   void add_to_snapshot(io::SnapshotWriter<3>& w, double t, const Capsule<3>& c) const {
     const auto X = c.positions();
     const auto& tris = fem_->triangles();
@@ -201,7 +225,7 @@ class CapsuleTrack<3> {
   double volume0_ = 0, area0_ = 0;
   std::size_t tracked_ = 0;
   diagnostics::EquivalentEllipsoid shape_;
-  diagnostics::AngleUnwrapper inclination_{std::numbers::pi}, phase_{2 * std::numbers::pi};
+  TrackAngles angles_;
   double theta_ = 0.0, phi_ = 0.0;
 };
 

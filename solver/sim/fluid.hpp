@@ -103,6 +103,17 @@ class Fluid {
     core::timed(coupling_seconds_, [&] { coupling_.restrict_to_coarse(c.pop, f.pop); });
   }
 
+  /// The evolving state (io/checkpoint.hpp archive): populations of every block and the coarse
+  /// history of the coupling. Force fields are not part of it: between steps they hold the
+  /// uniform body force except at the nodes of the last IB stencils, and a restored scene starts
+  /// with no stencil, i.e. the field as built (see ForcingHook).
+  template <class Archive>
+  void checkpoint(Archive& ar) {
+    for (std::size_t b = 0; b < blocks_.size(); ++b) blocks_[b].pop.checkpoint(ar, "fluid/block" + std::to_string(b) + "/");
+    if (two_level()) coupling_.checkpoint(ar, "fluid/coupling/");
+    ar("fluid/coupling_seconds", coupling_seconds_);
+  }
+
   /// Wall time spent in the multi-block coupling so far (part of the step time).
   double coupling_seconds() const { return coupling_seconds_; }
 

@@ -1,6 +1,13 @@
 #include "sim/run_case.hpp"
 
+#include <fmt/format.h>
+
+#include <cstdlib>
+
+#include "case/load_case.hpp"
+#include "core/build_info.hpp"
 #include "core/threads.hpp"
+#include "io/checkpoint.hpp"
 #include "io/manifest.hpp"
 #include "lattice/lattice.hpp"
 
@@ -8,57 +15,75 @@ namespace caplab::sim {
 
 namespace {
 
+/// What every template instance of a run needs besides the case.
+struct Drive {
+  io::RunDirectory& dir;
+  const ProgressFn& progress;
+  const CheckpointPolicy& policy;
+  io::CheckpointReader* restore_from;  // resumed run: the checkpoint to continue from
+};
+
 template <class L, class T, class Op>
-RunResult run_scene(const cases::CaseSpec& spec, const LatticeUnits& units, const Op& op, io::RunDirectory& dir,
-                    const ProgressFn& progress) {
+RunResult run_scene(const cases::CaseSpec& spec, const LatticeUnits& units, const Op& op, const Drive& d) {
   Scene<L, T, Op> scene(spec, units, op);
-  return scene.run(dir, progress);
+  if (d.restore_from) scene.restore(*d.restore_from);
+  return scene.run(d.dir, d.progress, d.policy);
 }
 
 template <class L, class T>
-RunResult dispatch_operator(const cases::CaseSpec& spec, const LatticeUnits& units, io::RunDirectory& dir,
-                            const ProgressFn& progress) {
+RunResult dispatch_operator(const cases::CaseSpec& spec, const LatticeUnits& units, const Drive& d) {
   const double tau = units.blocks[0].tau;
   if (spec.numerics.collision.op == cases::CollisionSpec::Operator::trt)
-    return run_scene<L, T>(spec, units, collision::Trt{tau, spec.numerics.collision.magic}, dir, progress);
-  return run_scene<L, T>(spec, units, collision::Bgk{tau}, dir, progress);
+    return run_scene<L, T>(spec, units, collision::Trt{tau, spec.numerics.collision.magic}, d);
+  return run_scene<L, T>(spec, units, collision::Bgk{tau}, d);
 }
 
 template <class L>
-RunResult dispatch_precision(const cases::CaseSpec& spec, const LatticeUnits& units, io::RunDirectory& dir,
-                             const ProgressFn& progress) {
-  if (spec.numerics.precision == cases::Precision::single) return dispatch_operator<L, float>(spec, units, dir, progress);
-  return dispatch_operator<L, double>(spec, units, dir, progress);
+RunResult dispatch_precision(const cases::CaseSpec& spec, const LatticeUnits& units, const Drive& d) {
+  if (spec.numerics.precision == cases::Precision::single) return dispatch_operator<L, float>(spec, units, d);
+  return dispatch_operator<L, double>(spec, units, d);
 }
 
-}  // namespace
+/// What a checkpoint stores besides the state: how to rebuild the case exactly (the document as
+/// read, the level, the overrides) and what built and ran it.
+nlohmann::json checkpoint_meta(const cases::CaseSpec& spec, int threads) {
+  const auto& b = core::build_info();
+  return {{"format", 1},
+          {"source_file", spec.source_file},
+          {"document", spec.document},
+          {"fidelity", spec.fidelity},
+          {"overrides", spec.overrides},
+          {"resolved", spec.resolved},
+          {"threads", threads},
+          {"git_sha", std::string(b.git_sha)},
+          {"git_dirty", b.git_dirty},
+          {"compiler", std::string(b.compiler)},
+          {"flags", std::string(b.flags)}};
+}
 
-std::string supported_combinations() { return "dimension 2 (D2Q9) or 3 (D3Q19) × precision double|single × collision bgk|trt"; }
-
-RunResult run_case(const cases::CaseSpec& spec, const std::filesystem::path& out, const ProgressFn& progress) {
-  const LatticeUnits units = derive_units(spec);  // input errors surface before the directory exists
-  const int threads = core::apply_thread_count(spec.numerics.threads);
-  auto dir = io::RunDirectory::create(out, /*overwrite=*/true);
-  nlohmann::json resolved = spec.resolved;
-  resolved["fidelity_applied"] = spec.fidelity;
-  dir.write_json("case.json", resolved);
-  dir.update_manifest({{"case_id", spec.id},
-                       {"fidelity", spec.fidelity},
-                       {"case_file", spec.source_file},
-                       {"threads", threads},
-                       {"environment", io::environment_json(threads)},
-                       {"lattice", units.to_json()}});
+/// Runs the scene of `spec` in `dir` (fresh, or continued from `restore_from`) and finishes the
+/// manifest with the final status.
+RunResult drive(const cases::CaseSpec& spec, const LatticeUnits& units, int threads, io::RunDirectory& dir,
+                const ProgressFn& progress, const RunOptions& options, io::CheckpointReader* restore_from) {
+  CheckpointPolicy policy;
+  policy.interval = spec.outputs.checkpoint.interval;
+  policy.wall_seconds = spec.outputs.checkpoint.wall_seconds;
+  policy.meta = checkpoint_meta(spec, threads).dump();
+  if (const char* kill = std::getenv("CAPLAB_TEST_KILL_AFTER_CHECKPOINT")) policy.kill_after = std::atoi(kill);
+  const Drive d{dir, progress, policy, restore_from};
   try {
-    RunResult r = spec.physics.dimension == 2 ? dispatch_precision<lattice::D2Q9>(spec, units, dir, progress)
-                                              : dispatch_precision<lattice::D3Q19>(spec, units, dir, progress);
+    RunResult r = spec.physics.dimension == 2 ? dispatch_precision<lattice::D2Q9>(spec, units, d)
+                                              : dispatch_precision<lattice::D3Q19>(spec, units, d);
     dir.write_json("summary.json", r.summary);
+    if (!options.keep_checkpoint) std::filesystem::remove(dir.path("checkpoint.h5"));
     nlohmann::json share = nlohmann::json::object();
     for (const auto& [k, v] : r.stage_seconds.items()) share[k] = v.get<double>() / r.wall_seconds;
     dir.finish("ok", {{"wall_time_s", r.wall_seconds},
                       {"steps", r.steps},
                       {"mlups", r.mlups},
                       {"stage_seconds", r.stage_seconds},
-                      {"stage_share", share}});
+                      {"stage_share", share},
+                      {"checkpoints", r.checkpoints}});
     return r;
   } catch (const core::NumericalError& e) {
     dir.finish("diverged", {{"error", e.what()}, {"step", e.step()}, {"where", e.where()}, {"cause", e.cause()}});
@@ -70,6 +95,64 @@ RunResult run_case(const cases::CaseSpec& spec, const std::filesystem::path& out
     dir.finish("failed", {{"error", e.what()}});
     throw;
   }
+}
+
+}  // namespace
+
+std::string supported_combinations() { return "dimension 2 (D2Q9) or 3 (D3Q19) × precision double|single × collision bgk|trt"; }
+
+RunResult run_case(const cases::CaseSpec& spec, const std::filesystem::path& out, const ProgressFn& progress,
+                   const RunOptions& options) {
+  const LatticeUnits units = derive_units(spec);  // input errors surface before the directory exists
+  check_memory(spec, units, machine_memory_bytes());  // and before anything large is allocated
+  const int threads = core::apply_thread_count(spec.numerics.threads);
+  auto dir = io::RunDirectory::create(out, /*overwrite=*/true);
+  nlohmann::json resolved = spec.resolved;
+  resolved["fidelity_applied"] = spec.fidelity;
+  dir.write_json("case.json", resolved);
+  dir.update_manifest({{"case_id", spec.id},
+                       {"fidelity", spec.fidelity},
+                       {"case_file", spec.source_file},
+                       {"threads", threads},
+                       {"environment", io::environment_json(threads)},
+                       {"lattice", units.to_json()}});
+  return drive(spec, units, threads, dir, progress, options, nullptr);
+}
+
+ResumedRun resume_case(const std::filesystem::path& run_dir, int threads, const ProgressFn& progress,
+                       const RunOptions& options) {
+  io::RunDirectory::check_resumable(run_dir);  // before anything in the directory changes
+  io::CheckpointReader reader(run_dir / "checkpoint.h5");
+  std::string meta_text;
+  reader("meta", meta_text);
+  const auto meta = nlohmann::json::parse(meta_text);
+  cases::CaseSpec spec = cases::parse_case(meta.at("document"), meta.at("source_file").get<std::string>(),
+                                           meta.at("fidelity").get<std::string>(),
+                                           meta.at("overrides").get<std::vector<std::string>>());
+  if (spec.resolved != meta.at("resolved"))
+    throw core::InputError("the checkpoint in '" + run_dir.string() +
+                           "' was written by a caplab whose case defaults differ from this one (git " +
+                           meta.at("git_sha").get<std::string>() + "); resume it with that build or run it afresh");
+  const int saved_threads = meta.at("threads").get<int>();
+  spec.numerics.threads = threads > 0 ? threads : saved_threads;
+  const LatticeUnits units = derive_units(spec);
+  check_memory(spec, units, machine_memory_bytes());  // the machine resumed on may have less
+  const int used = core::apply_thread_count(spec.numerics.threads);
+  const auto& b = core::build_info();
+  std::vector<std::string> warnings;
+  if (used != saved_threads)
+    warnings.push_back(fmt::format("the run started with {} threads and continues with {}: results agree to "
+                                   "round-off, not bit for bit",
+                                   saved_threads, used));
+  if (meta.at("git_sha").get<std::string>() != b.git_sha || meta.at("git_dirty").get<bool>() != b.git_dirty ||
+      meta.at("flags").get<std::string>() != std::string(b.flags))
+    warnings.push_back("the run started with another build of caplab (git " + meta.at("git_sha").get<std::string>() +
+                       "): results may differ from an uninterrupted run at round-off");
+  auto dir = io::RunDirectory::resume(run_dir);
+  dir.update_manifest({{"threads", used}, {"environment", io::environment_json(used)}});
+  ResumedRun r{spec, warnings, {}};
+  r.result = drive(spec, units, used, dir, progress, options, &reader);
+  return r;
 }
 
 }  // namespace caplab::sim

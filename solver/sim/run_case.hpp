@@ -10,11 +10,34 @@
 
 namespace caplab::sim {
 
+/// Choices of the command line that are not part of the case.
+struct RunOptions {
+  bool keep_checkpoint = false;  ///< keep checkpoint.h5 when the run finishes ok
+};
+
 /// Runs `spec` into the run directory `out` (created fresh; a previous run there is
-/// replaced). Writes case.json, manifest.json, series.h5, snapshots, summary.json.
+/// replaced). Writes case.json, manifest.json, series.h5, snapshots, summary.json, and
+/// checkpoint.h5 as outputs.checkpoint asks (removed at the end unless options keep it).
 /// On a numerical instability the manifest is finished as "diverged" and the
 /// core::NumericalError propagates; on any other failure "failed" and the error propagates.
-RunResult run_case(const cases::CaseSpec& spec, const std::filesystem::path& out, const ProgressFn& progress);
+RunResult run_case(const cases::CaseSpec& spec, const std::filesystem::path& out, const ProgressFn& progress,
+                   const RunOptions& options = {});
+
+/// A run continued by resume_case: the case as rebuilt from the checkpoint, what the user
+/// should know (another thread count or build), and the result.
+struct ResumedRun {
+  cases::CaseSpec spec;
+  std::vector<std::string> warnings;
+  RunResult result;
+};
+
+/// Continues the interrupted run in `run_dir` from its checkpoint.h5 (`caplab run --resume`):
+/// the case is rebuilt from the checkpoint (the document, level and overrides it was started
+/// with), with `threads` (0: the thread count it was started with). At the same thread count
+/// and build the outputs are bit for bit those of an uninterrupted run. Refuses (InputError)
+/// a run that finished, diverged or was refused, and a directory without a checkpoint.
+ResumedRun resume_case(const std::filesystem::path& run_dir, int threads, const ProgressFn& progress,
+                       const RunOptions& options = {});
 
 /// The supported combinations, for messages: "2D/3D × double/single × bgk/trt".
 std::string supported_combinations();

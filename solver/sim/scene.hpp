@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdint>
 #include <functional>
 #include <fmt/format.h>
@@ -32,6 +33,7 @@
 #include "geometry/closed_curve.hpp"
 #include "geometry/marker_set.hpp"
 #include "ibm/direct_forcing.hpp"
+#include "io/checkpoint.hpp"
 #include "io/run_directory.hpp"
 #include "io/series_writer.hpp"
 #include "io/snapshot_writer.hpp"
@@ -43,8 +45,19 @@
 
 namespace caplab::sim {
 
-/// Called about once a second: step, total steps, time (L/U), MLUPS so far.
-using ProgressFn = std::function<void(long, long, double, double)>;
+/// Called about once a second: step, total steps, time (L/U), MLUPS and the estimated seconds
+/// left, both from the steps this process has run.
+using ProgressFn = std::function<void(long, long, double, double, double)>;
+
+/// When and how a run writes checkpoint.h5 (sim/run_case.cpp fills it from the case).
+struct CheckpointPolicy {
+  double interval = 0;      ///< simulated time between checkpoints, L/U (0: not by time)
+  double wall_seconds = 0;  ///< wall time between checkpoints (0: not by wall time)
+  std::string meta;         ///< stored with the state: the case and the build (JSON text)
+  /// Tests only: the process kills itself (SIGKILL) right after its n-th checkpoint, as a
+  /// power cut would (CAPLAB_TEST_KILL_AFTER_CHECKPOINT, read by sim/run_case.cpp).
+  int kill_after = 0;
+};
 
 struct RunResult {
   long steps = 0;
@@ -52,6 +65,7 @@ struct RunResult {
   double mlups = 0;
   nlohmann::json stage_seconds;
   nlohmann::json summary;  ///< the content of summary.json
+  nlohmann::json checkpoints;  ///< count, seconds, bytes of the checkpoints written
 };
 
 template <class L, class T, class Op>
@@ -74,46 +88,87 @@ class Scene {
     });
   }
 
-  RunResult run(io::RunDirectory& dir, const ProgressFn& progress) {
-    using clock = std::chrono::steady_clock;
-    const auto start = clock::now();
+  /// Restores the state of a checkpoint written by an earlier run of the same case (the
+  /// scene is built as for a fresh run first); run() then continues after its step.
+  void restore(io::CheckpointReader& ar) { checkpoint(ar); }
+
+  RunResult run(io::RunDirectory& dir, const ProgressFn& progress, const CheckpointPolicy& policy = {}) {
+    start_ = clock::now();
+    const bool resumed = step_ > 0;
     const double dt = units_.blocks[0].dt;
     const long total = units_.coarse_steps;
     const long sample_every = std::max(1L, std::lround(spec_.outputs.series.interval / dt));
-    const long guard_every = 100;
+    const long guard_every = spec_.numerics.guards.every;
     std::vector<long> snapshot_steps;
     for (double ts : spec_.outputs.snapshots.times) snapshot_steps.push_back(std::lround(std::ceil(ts / dt - 1e-9)));
 
+    // A resumed run rewrites the series it had at its checkpoint and continues the snapshot file.
     io::SeriesWriter series(dir.partial_path("series.h5"), columns_, {{"case_id", spec_.id}, {"fidelity", spec_.fidelity}});
+    const std::size_t width = columns_.size();
+    for (std::size_t r = 0; r < series_rows_.size(); r += width)
+      series.append(std::span<const double>(series_rows_).subspan(r, width));
     std::optional<io::SnapshotWriter<D>> snapshots;
-    if (!snapshot_steps.empty())
-      snapshots.emplace(dir.partial_path("snapshots.h5"), dir.path("snapshots.xdmf"), "snapshots.h5",
-                        nlohmann::json{{"case_id", spec_.id}});
+    if (!snapshot_steps.empty()) {
+      if (resumed)
+        snapshots.emplace(io::SnapshotWriter<D>::reopen(dir.partial_path("snapshots.h5"), dir.path("snapshots.xdmf"),
+                                                        "snapshots.h5", nlohmann::json::parse(snapshot_index_)));
+      else
+        snapshots.emplace(dir.partial_path("snapshots.h5"), dir.path("snapshots.xdmf"), "snapshots.h5",
+                          nlohmann::json{{"case_id", spec_.id}});
+    }
 
-    mass0_ = total_mass();
-    // A snapshot at t = 0 is the initial state (the rest shape of the capsules, the imposed flow).
-    if (snapshots && std::find(snapshot_steps.begin(), snapshot_steps.end(), 0L) != snapshot_steps.end())
-      core::timed(seconds_output_, [&] { write_snapshot(*snapshots, 0.0); });
+    if (!resumed) {
+      mass0_ = total_mass();
+      // A snapshot at t = 0 is the initial state (the rest shape of the capsules, the imposed flow).
+      if (snapshots && std::find(snapshot_steps.begin(), snapshot_steps.end(), 0L) != snapshot_steps.end())
+        core::timed(seconds_output_, [&] { write_snapshot(*snapshots, 0.0); });
+    }
+    const long every_steps = policy.interval > 0 ? std::max(1L, std::lround(policy.interval / dt)) : 0;
+    auto last_checkpoint = clock::now();
     auto last_report = clock::now();
     auto hook = [&](const typename FluidT::Pop& pop, typename FluidT::Force& f) { return apply_ib(pop, f); };
-    std::vector<double> row(columns_.size());
-    for (long step = 1; step <= total; ++step) {
-      step_ = step;
-      core::timed(seconds_fluid_, [&] { fluid_.step(hook); });
-      const double t = step * dt;
-      if (!capsules_.empty()) core::timed(seconds_diagnostics_, [&] { track_capsules(); });
-      if (step % guard_every == 0 || step == total) core::timed(seconds_diagnostics_, [&] { check_guards(step); });
-      if (step % sample_every == 0 || step == total) {
-        core::timed(seconds_diagnostics_, [&] { sample(t, row); });
-        core::timed(seconds_output_, [&] { series.append(row); });
+    std::vector<double> row(width);
+    try {
+      for (long step = step_ + 1; step <= total; ++step) {
+        step_ = step;
+        core::timed(seconds_fluid_, [&] { fluid_.step(hook); });
+        const double t = step * dt;
+        if (!capsules_.empty()) core::timed(seconds_diagnostics_, [&] { track_capsules(); });
+        const bool checkpoint_due =
+            step < total && ((every_steps > 0 && step % every_steps == 0) ||
+                             (policy.wall_seconds > 0 && seconds_since(last_checkpoint) >= policy.wall_seconds));
+        // A checkpoint is always a state that passed the guards (the last good state).
+        if (step % guard_every == 0 || step == total || checkpoint_due)
+          core::timed(seconds_diagnostics_, [&] { check_guards(step); });
+        if (step % sample_every == 0 || step == total) {
+          core::timed(seconds_diagnostics_, [&] { sample(t, row); });
+          core::timed(seconds_output_, [&] { series.append(row); });
+          series_rows_.insert(series_rows_.end(), row.begin(), row.end());
+        }
+        if (snapshots && std::find(snapshot_steps.begin(), snapshot_steps.end(), step) != snapshot_steps.end())
+          core::timed(seconds_output_, [&] { write_snapshot(*snapshots, t); });
+        if (checkpoint_due) {
+          write_checkpoint(dir, snapshots ? &*snapshots : nullptr, policy);
+          last_checkpoint = clock::now();
+        }
+        if (progress && clock::now() - last_report > std::chrono::seconds(1)) {
+          const double per_step = seconds_since(start_) / static_cast<double>(step - first_step_);
+          progress(step, total, t, fluid_.updates_per_step() / per_step / 1e6, per_step * static_cast<double>(total - step));
+          last_report = clock::now();
+        }
       }
-      if (snapshots && std::find(snapshot_steps.begin(), snapshot_steps.end(), step) != snapshot_steps.end())
-        core::timed(seconds_output_, [&] { write_snapshot(*snapshots, t); });
-      if (progress && clock::now() - last_report > std::chrono::seconds(1)) {
-        const double wall = std::chrono::duration<double>(clock::now() - start).count();
-        progress(step, total, t, fluid_.updates_per_step() * step / wall / 1e6);
-        last_report = clock::now();
-      }
+    } catch (const core::NumericalError& e) {
+      // What the run wrote stays readable as .partial files (never a result), and the message
+      // says where the last good state is.
+      series.close();
+      if (snapshots) snapshots->close();
+      const std::string kept =
+          checkpoints_.count > 0
+              ? fmt::format(" The last good state (step {}, t = {:.6g} L/U) is kept in {}.", checkpoints_.last_step,
+                            checkpoints_.last_step * dt, dir.path("checkpoint.h5").string())
+              : std::string(" No checkpoint was written before the failure.");
+      throw core::NumericalError(e.step(), e.where(), e.quantity(),
+                                 e.cause() + ". The series up to the failure is in series.h5.partial." + kept);
     }
     series.close();
     dir.commit_file("series.h5");
@@ -124,8 +179,13 @@ class Scene {
 
     RunResult r;
     r.steps = total;
-    r.wall_seconds = std::chrono::duration<double>(clock::now() - start).count();
+    r.wall_seconds = wall_before_ + seconds_since(start_);
     r.mlups = fluid_.updates_per_step() * total / r.wall_seconds / 1e6;
+    r.checkpoints = {{"count", checkpoints_.count},
+                     {"seconds", checkpoints_.seconds},
+                     {"bytes", checkpoints_.bytes},
+                     {"interval", policy.interval},
+                     {"wall_seconds", policy.wall_seconds}};
     const double coupling = fluid_.coupling_seconds();
     // The IB hook runs inside the fluid step: report it apart from the fluid update.
     r.stage_seconds = {{"fluid", seconds_fluid_ - coupling - seconds_ib_ - seconds_membrane_},
@@ -139,6 +199,64 @@ class Scene {
   }
 
  private:
+  using clock = std::chrono::steady_clock;
+  static double seconds_since(clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); }
+
+  /// Everything that evolves (io/checkpoint.hpp archive). What is not here is rebuilt from the
+  /// case by the constructor or recomputed by the next step before it is read: the force fields
+  /// (see Fluid::checkpoint), the IB stencils, membrane forces and node velocities, the shapes
+  /// of the capsule tracks, the poses of moving bodies (exact functions of time).
+  template <class Archive>
+  void checkpoint(Archive& ar) {
+    ar("scene/step", step_);
+    ar("scene/fine_steps", fine_steps_);
+    ar("scene/mass0", mass0_);
+    double wall = wall_before_ + (Archive::loading ? 0.0 : seconds_since(start_));
+    ar("scene/wall_seconds", wall);
+    const std::initializer_list<std::pair<const char*, double*>> stages = {
+        {"fluid", &seconds_fluid_}, {"ib", &seconds_ib_}, {"membrane", &seconds_membrane_},
+        {"diagnostics", &seconds_diagnostics_}, {"output", &seconds_output_}};
+    for (const auto& [name, value] : stages)
+      ar(std::string("scene/seconds/") + name, *value);
+    fluid_.checkpoint(ar);
+    for (std::size_t c = 0; c < capsules_.size(); ++c) {
+      const std::string prefix = "capsules/" + std::to_string(c) + "/";
+      capsules_[c].checkpoint(ar, prefix);
+      capsule_tracks_[c].checkpoint(ar, prefix + "track/");
+    }
+    ar("series/rows", series_rows_);
+    ar("snapshots/index", snapshot_index_);
+    ar("checkpoints/count", checkpoints_.count);
+    ar("checkpoints/seconds", checkpoints_.seconds);
+    if constexpr (Archive::loading) {
+      wall_before_ = wall;
+      first_step_ = step_;
+      checkpoints_.last_step = step_;
+    }
+  }
+
+  /// Writes checkpoint.h5 atomically (complete or absent) after `step_`; `policy.meta` (the case
+  /// and the build) is stored with the state. Counts its cost.
+  void write_checkpoint(io::RunDirectory& dir, const io::SnapshotWriter<D>* snapshots, const CheckpointPolicy& policy) {
+    const auto t0 = clock::now();
+    snapshot_index_ = snapshots ? snapshots->index().dump() : "[]";
+    ++checkpoints_.count;
+    {
+      io::CheckpointWriter w(dir.partial_path("checkpoint.h5"));
+      std::string meta = policy.meta;
+      w("meta", meta);
+      checkpoint(w);
+      w.close();
+      checkpoints_.bytes = static_cast<double>(w.file_bytes());
+    }
+    dir.commit_file("checkpoint.h5");
+    checkpoints_.last_step = step_;
+    const double spent = seconds_since(t0);
+    checkpoints_.seconds += spent;
+    seconds_output_ += spent;
+    if (policy.kill_after > 0 && ++checkpoints_this_process_ == policy.kill_after) std::raise(SIGKILL);
+  }
+
   struct RigidBody {
     std::string name;
     cases::ShapeSpec shape;
@@ -288,9 +406,18 @@ class Scene {
     }
   }
 
-  /// Shape of each capsule after a coarse step (capsule_track.hpp).
+  /// Shape of each capsule after a coarse step (capsule_track.hpp). A surface the shape
+  /// diagnostics reject (it encloses no volume, a non-finite node) is a membrane that has
+  /// diverged: exit 3, like the guards, not a failure of the program.
   void track_capsules() {
-    for (std::size_t c = 0; c < capsules_.size(); ++c) capsule_tracks_[c].update(capsules_[c]);
+    for (std::size_t c = 0; c < capsules_.size(); ++c) {
+      try {
+        capsule_tracks_[c].update(capsules_[c]);
+      } catch (const core::Error& e) {
+        throw core::NumericalError(step_, fmt::format("capsule '{}'", capsules_[c].name()), e.what(),
+                                   diverged_membrane(capsules_[c]));
+      }
+    }
   }
 
   /// Transverse velocity blob (lattice units) 1.5 D downstream of each body, width D/2
@@ -376,7 +503,7 @@ class Scene {
     core::timed(seconds_ib_, [&] {
       for (auto& c : capsules_) {
         if (bodies_.empty()) c.restore(f, base);  // with rigid bodies, force_bodies restored the field
-        guarded(c.name(), [&] { c.spread(pop.grid(), periodic_, f); });
+        guarded(c, [&] { c.spread(pop.grid(), periodic_, f); });
       }
       // The velocity the forced collision uses, once per stencil node (stencils overlap).
       collect_forced_nodes(pop.grid().size());
@@ -393,19 +520,31 @@ class Scene {
     });
   }
 
-  /// Runs f(); a core::Error from the IB stage (a stencil off the block, a non-finite
-  /// position) becomes a NumericalError naming the body, the step and the likely cause.
+  /// The likely cause of a membrane that has blown up, with the state of its elements.
+  static std::string diverged_membrane(const Capsule<D>& c) {
+    const auto h = c.membrane().health(c.positions());
+    return fmt::format("the membrane nodes diverged (elements at {:.3g} to {:.3g} times their rest size{}): the "
+                       "explicit membrane-fluid coupling is too stiff for the time step, which happens at small "
+                       "capillary numbers G; lower numerics.lattice_velocity (a smaller time step) or refine the grid",
+                       h.min_ratio, h.max_ratio, h.folded >= 0 ? ", folded" : "");
+  }
+
+  /// Runs f() for capsule `c`; a core::Error from the IB stage (a stencil off the block, a
+  /// non-finite position) becomes a NumericalError naming the capsule, the step and, from the
+  /// state of its membrane, which of the two usual causes it is.
   template <class F>
-  void guarded(const std::string& body, F&& f) const {
+  void guarded(const Capsule<D>& c, F&& f) const {
     try {
       f();
     } catch (const core::NumericalError&) {
       throw;
     } catch (const core::Error& e) {
-      throw core::NumericalError(step_, fmt::format("immersed boundary of body '{}'", body), e.what(),
-                                 "the membrane left the fine block or its nodes diverged: enlarge the fine "
-                                 "region, lower the capillary number G or the time step (numerics.lattice_velocity), "
-                                 "or use more membrane nodes");
+      const auto h = c.membrane().health(c.positions());
+      const bool exploded = !(h.max_ratio < 3.0) || !(h.min_ratio > spec_.numerics.guards.min_area_ratio) || h.folded >= 0;
+      throw core::NumericalError(step_, fmt::format("immersed boundary of capsule '{}'", c.name()), e.what(),
+                                 exploded ? diverged_membrane(c)
+                                          : "the capsule left the fine block with a healthy membrane: enlarge the fine "
+                                            "region (numerics.grid.fine_region) or move the capsule away from its edge");
     }
   }
 
@@ -596,9 +735,18 @@ class Scene {
     return integrate([](double rho, const Vec<D>&) { return rho; });
   }
 
-  /// Stops the run with the step, the place and the likely cause when the flow has left
-  /// the range where the method is valid (non-finite, Mach, density).
+  static std::string position_text(const Vec<D>& x) {
+    std::string pos = fmt::format("{:.4g}", x[0]);
+    for (int a = 1; a < D; ++a) pos += fmt::format(", {:.4g}", x[a]);
+    return pos;
+  }
+
+  /// Stops the run with the step, the place and the likely cause when it has left the range
+  /// where the method is valid (numerics.guards): non-finite, Mach or density on any block;
+  /// a capsule's volume drift, a collapsed or folded membrane element. Markers leaving the
+  /// fine block are caught by the IB stage itself (guarded()).
   void check_guards(long step) const {
+    const auto& g = spec_.numerics.guards;
     for (std::size_t b = 0; b < fluid_.block_count(); ++b) {
       const auto& blk = fluid_.block(b);
       const auto& grid = blk.pop.grid();
@@ -611,22 +759,53 @@ class Scene {
         for (int a = 0; a < D; ++a) u2 += m.u[a] * m.u[a];
         if (!std::isfinite(m.rho) || !std::isfinite(u2))
           problem = "non-finite density or velocity";
-        else if (std::sqrt(3.0 * u2) > 1.0)
-          problem = fmt::format("local Mach number {:.2f} above 1", std::sqrt(3.0 * u2));
-        else if (std::abs(m.rho - 1.0) > 0.3)
-          problem = fmt::format("density {:.3f} deviates by more than 30 % from 1", m.rho);
+        else if (std::sqrt(3.0 * u2) > g.max_mach)
+          problem = fmt::format("local Mach number {:.3f} above numerics.guards.max_mach = {}", std::sqrt(3.0 * u2),
+                                g.max_mach);
+        else if (std::abs(m.rho - 1.0) > g.max_density_deviation)
+          problem = fmt::format("density {:.4f} deviates from 1 by more than numerics.guards.max_density_deviation = {}",
+                                m.rho, g.max_density_deviation);
         if (!problem.empty()) where = ijk;
       });
-      if (!problem.empty()) {
-        const Vec<D> x = grid.position(where);
-        std::string pos = fmt::format("{:.4g}", x[0]);
-        for (int a = 1; a < D; ++a) pos += fmt::format(", {:.4g}", x[a]);
+      if (!problem.empty())
         throw core::NumericalError(
-            step, fmt::format("{} block, node at ({}) L", units_.blocks[b].name, pos), problem,
+            step, fmt::format("{} block, node at ({}) L", units_.blocks[b].name, position_text(grid.position(where))),
+            problem,
             fmt::format("tau = {:.4f} on this block is close to 1/2 or the lattice velocity {:.3g} is too high for "
                         "this Reynolds number; use the TRT operator, refine the grid or lower numerics.lattice_velocity",
                         units_.blocks[b].tau, units_.velocity_lu));
-      }
+    }
+    for (std::size_t c = 0; c < capsules_.size(); ++c) {
+      const auto& cap = capsules_[c];
+      const double dv = capsule_tracks_[c].volume_change();
+      const char* volume = D == 2 ? "enclosed area" : "volume";
+      if (!(std::abs(dv) <= g.max_volume_change))
+        throw core::NumericalError(
+            step, fmt::format("capsule '{}'", cap.name()),
+            fmt::format("{} changed by {:.3g} % (numerics.guards.max_volume_change = {:.3g} %)", volume, 100 * dv,
+                        100 * g.max_volume_change),
+            "fluid crosses the membrane: the membrane nodes are too far apart for the IB kernel (more nodes or "
+            "subdivisions), the capsule is too coarse on the grid, or tau is large (slip through the diffuse "
+            "interface); if this drift is expected, raise numerics.guards.max_volume_change");
+      const auto h = cap.membrane().health(cap.positions());
+      const char* element = D == 2 ? "segment" : "element";
+      if (h.folded >= 0)
+        throw core::NumericalError(
+            step, fmt::format("capsule '{}', membrane {} {} at ({}) L", cap.name(), element, h.folded,
+                              position_text(h.folded_at)),
+            fmt::format("the {} is folded over its neighbours (inverted)", element),
+            "either the explicit coupling is too stiff for the time step (a small capillary number G: lower "
+            "numerics.lattice_velocity or refine the grid), or the membrane buckles or wrinkles below what its mesh "
+            "resolves (the thesis reports wrinkles in long runs: a finer membrane or bending stiffness)");
+      if (!(h.min_ratio >= g.min_area_ratio))
+        throw core::NumericalError(
+            step, fmt::format("capsule '{}', membrane {} {} at ({}) L", cap.name(), element, h.worst,
+                              position_text(h.worst_at)),
+            fmt::format("the {} has shrunk to {:.3g} of its rest {} (numerics.guards.min_area_ratio = {})", element,
+                        h.min_ratio, D == 2 ? "length" : "area", g.min_area_ratio),
+            "the membrane is compressed far beyond its rest state: the explicit coupling is too stiff for the time "
+            "step (small G: lower numerics.lattice_velocity), or the deformation is larger than the mesh resolves "
+            "(large G: a finer membrane; for Skalak a larger area_dilation C)");
     }
   }
 
@@ -822,7 +1001,17 @@ class Scene {
   std::array<bool, D> periodic_{};
   std::vector<io::SeriesColumn> columns_;
   double mass0_ = 1.0;
-  long step_ = 0;  // the coarse step in progress (for messages)
+  long step_ = 0;  // the coarse step in progress (for messages); after restore(), the last one done
+  long first_step_ = 0;  // step_ when this process started running (MLUPS of the progress line)
+  clock::time_point start_ = clock::now();
+  double wall_before_ = 0;  // wall time of the earlier processes of a resumed run
+  std::vector<double> series_rows_;  // every row written so far (a resumed run rewrites them)
+  std::string snapshot_index_ = "[]";  // SnapshotWriter::index() at the last checkpoint
+  struct {
+    long count = 0, last_step = 0;
+    double seconds = 0, bytes = 0;
+  } checkpoints_;
+  int checkpoints_this_process_ = 0;
   double seconds_fluid_ = 0, seconds_ib_ = 0, seconds_membrane_ = 0, seconds_diagnostics_ = 0, seconds_output_ = 0;
 };
 

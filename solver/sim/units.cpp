@@ -2,7 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <string>
 
 #include "core/error.hpp"
 
@@ -102,9 +108,10 @@ LatticeUnits derive_units(const CaseSpec& spec) {
     lu.blocks.push_back(fine);
   }
   for (const auto& b : lu.blocks)
-    if (b.tau <= 0.5 + 1e-9)
+    if (!(b.tau > 0.5 + 1e-9 && std::isfinite(b.tau)))  // a tiny Re overflows the viscosity to inf
       throw core::InputError(spec.source_file, "/physics/reynolds", fmt::format("{}", spec.physics.reynolds),
-                             fmt::format("a Reynolds number giving tau > 0.5 on block {} (got tau = {:.6f})", b.name, b.tau));
+                             fmt::format("a Reynolds number giving a finite tau > 0.5 on block {} (got tau = {:.6f})",
+                                         b.name, b.tau));
 
   // Largest imposed speed: uniform flow 1, shear k·(half height), else 1 (a scale).
   double umax = 1.0;
@@ -116,18 +123,88 @@ LatticeUnits derive_units(const CaseSpec& spec) {
                                        "speed is {:.3g} U, Mach {:.3f}); lower lattice_velocity",
                                        umax, lu.mach));
 
-  lu.coarse_steps = static_cast<long>(std::ceil(spec.numerics.end_time / lu.blocks[0].dt - 1e-9));
+  // In double first: end_time / dt can exceed every integer type (the cast would be undefined).
+  const double steps = std::ceil(spec.numerics.end_time / lu.blocks[0].dt - 1e-9);
+  if (!(steps >= 1))
+    throw core::InputError(spec.source_file, "/numerics/end_time", fmt::format("{}", spec.numerics.end_time),
+                           fmt::format("an end time of at least one coarse time step, {:.4g} L/U", lu.blocks[0].dt));
+  if (!(steps <= max_coarse_steps))
+    throw core::InputError(
+        spec.source_file, "/numerics/end_time", fmt::format("{}", spec.numerics.end_time),
+        fmt::format("an end time of at most {:g} coarse time steps of {:.4g} L/U (this one needs "
+                    "{:.3g}); shorten the run or coarsen the grid",
+                    max_coarse_steps, lu.blocks[0].dt, steps));
+  lu.coarse_steps = static_cast<long>(steps);
   double per_step = lu.blocks[0].node_count();
   if (two_level) per_step += 2.0 * lu.blocks[1].node_count();
   lu.node_updates = per_step * static_cast<double>(lu.coarse_steps);
-  const double bytes_per_value = spec.numerics.precision == cases::Precision::single ? 4.0 : 8.0;
-  const int q = D == 2 ? 9 : 19;
-  for (const auto& b : lu.blocks) {
-    double with_ghosts = 1;
-    for (int k : b.nodes) with_ghosts *= k + 2;
-    lu.memory_bytes += with_ghosts * (2.0 * q * bytes_per_value + D * 8.0);
-  }
+  lu.memory_bytes = estimate_memory_bytes(spec, lu.blocks);
   return lu;
+}
+
+double estimate_memory_bytes(const CaseSpec& spec, const std::vector<BlockUnits>& blocks) {
+  // What scales with the lattice (sim/fluid.hpp, sim/scene.hpp); every field includes the ghost
+  // layer. Markers, membrane meshes, the multi-block interface and the boundary lists grow with
+  // surfaces, not volumes, and are left to the margin of check_memory.
+  const int D = spec.physics.dimension;
+  const double value = spec.numerics.precision == cases::Precision::single ? 4.0 : 8.0;
+  const double q = D == 2 ? 9 : 19;
+  const bool body_force = spec.physics.flow.type == FlowSpec::Type::body_force;
+  const bool bodies = !spec.physics.bodies.empty();
+  const bool snapshots = !spec.outputs.snapshots.times.empty() && !spec.outputs.snapshots.fields.empty();
+  double bytes = 0, largest = 0;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    double n = 1;
+    for (int k : blocks[b].nodes) n *= k + 2.0;
+    largest = std::max(largest, n);
+    bytes += n * 2 * q * value;  // populations, two buffers (A-B pattern)
+    const bool finest = b + 1 == blocks.size();
+    if (body_force || (finest && bodies)) bytes += n * D * 8.0;  // force density (double)
+    if (finest && bodies) bytes += n * 8.0;                      // forced-node slot and stamp (int32 each)
+  }
+  // A snapshot holds density, velocity and vorticity (1 or 3 components) of one block at a
+  // time, in double, plus the copy of one field that the HDF5 writer makes.
+  if (snapshots) bytes += largest * 8.0 * (1 + D + (D == 2 ? 1 : 3) + 1);
+  return bytes;
+}
+
+double machine_memory_bytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  double bytes = pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0;
+  // A container may be given less than the machine has: cgroup v2, then v1 ("max" or a huge
+  // number when there is no limit).
+  for (const char* file : {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+    std::ifstream in(file);
+    std::string text;
+    if (!(in >> text) || text == "max") continue;
+    char* end = nullptr;
+    const double limit = std::strtod(text.c_str(), &end);
+    if (end != text.c_str() && limit > 0 && (bytes == 0 || limit < bytes)) bytes = limit;
+    break;
+  }
+  return bytes;
+}
+
+double usable_memory_bytes(double machine_bytes) {
+  return machine_bytes - std::max(memory_margin_share * machine_bytes, memory_margin_bytes);
+}
+
+void check_memory(const CaseSpec& spec, const LatticeUnits& units, double machine_bytes) {
+  if (!(machine_bytes > 0)) return;  // unknown: nothing to compare with
+  const double usable = usable_memory_bytes(machine_bytes);
+  if (units.memory_bytes <= usable) return;
+  constexpr double gib = 1024.0 * 1024.0 * 1024.0;
+  double nodes = 0;
+  for (const auto& b : units.blocks) nodes += b.node_count();
+  throw core::InputError(
+      spec.source_file, "/numerics/grid/fine_spacing",
+      fmt::format("{} (the run needs about {:.3g} GiB of memory for {:.3g} lattice nodes)",
+                  spec.numerics.grid.fine_spacing, units.memory_bytes / gib, nodes),
+      fmt::format(
+          "a case that fits in the memory of this machine: {:.3g} GiB, of which a run may use {:.3g} GiB; "
+          "use a coarser resolution (a larger numerics.grid.fine_spacing or a lower fidelity level), a "
+          "smaller domain or fine region, or numerics.precision \"single\" (halves the populations)",
+          machine_bytes / gib, std::max(0.0, usable) / gib));
 }
 
 nlohmann::json LatticeUnits::to_json() const {

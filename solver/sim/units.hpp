@@ -35,14 +35,41 @@ struct LatticeUnits {
   std::vector<BlockUnits> blocks;  ///< coarse first; one entry for a uniform grid
   long coarse_steps = 0;        ///< steps of the coarsest block to reach end_time
   double node_updates = 0;      ///< total node updates of the run
-  double memory_bytes = 0;      ///< populations (two buffers) plus force fields
+  double memory_bytes = 0;      ///< estimate_memory_bytes of the blocks
   double estimated_seconds(double mlups) const { return node_updates / (mlups * 1e6); }
   nlohmann::json to_json() const;
 };
 
+/// Most coarse time steps a run may take (beyond it end_time or the spacing is surely a typo).
+inline constexpr double max_coarse_steps = 1e11;
+/// What check_memory keeps free for the system and what does not scale with the lattice: this
+/// share of the machine's memory, and at least this many bytes.
+inline constexpr double memory_margin_share = 0.1;
+inline constexpr double memory_margin_bytes = 512.0 * 1024 * 1024;
+
 /// Derives the lattice parameters of a validated case. Throws core::InputError for
-/// combinations that are valid JSON but not a usable lattice (τ ≤ ½, Mach too high).
+/// combinations that are valid JSON but not a usable lattice (τ ≤ ½, Mach too high, more than
+/// max_coarse_steps steps).
 LatticeUnits derive_units(const cases::CaseSpec& spec);
+
+/// Bytes a run of `spec` on `blocks` allocates for what scales with the lattice: populations
+/// (two buffers, Q values of the case's precision per node), the force density of the finest
+/// block when it carries bodies (of every block with a body-force flow), the forced-node
+/// bookkeeping, and the fields of one block while a snapshot is written.
+double estimate_memory_bytes(const cases::CaseSpec& spec, const std::vector<BlockUnits>& blocks);
+
+/// Physical memory of this machine (sysconf pages × page size), or the cgroup memory limit of
+/// this process when that is lower; 0 when unknown.
+double machine_memory_bytes();
+
+/// What a run may allocate on a machine with `machine_bytes` of memory: all of it less a
+/// margin (memory_margin_share of it, at least memory_margin_bytes).
+double usable_memory_bytes(double machine_bytes);
+
+/// Throws core::InputError (at /numerics/grid/fine_spacing) when `units.memory_bytes` exceeds
+/// usable_memory_bytes(machine_bytes), naming the estimate, the machine's memory and the fixes.
+/// Called before anything is allocated or written; does nothing when machine_bytes is 0.
+void check_memory(const cases::CaseSpec& spec, const LatticeUnits& units, double machine_bytes);
 
 /// Imposed (unperturbed) velocity of the case's flow at position x (in L), in units of U.
 std::vector<double> imposed_velocity(const cases::CaseSpec& spec, const std::vector<double>& x);

@@ -314,7 +314,7 @@ TEST(case_rejects, NegativeReynolds) {
 TEST(case_rejects, OutOfRangeNumbers) {
   expect_set_rejected({"numerics.lattice_velocity=0.5"}, "/numerics/lattice_velocity",
                       {"0.5", "in (0, 0.4]"});
-  expect_set_rejected({"numerics.ib.forcing_iterations=0"}, "/numerics/ib/forcing_iterations", {">= 1"});
+  expect_set_rejected({"numerics.ib.forcing_iterations=0"}, "/numerics/ib/forcing_iterations", {"in [1, 100]"});
   expect_set_rejected({"acceptance.0.tolerance.standard=0"}, "/acceptance/0/tolerance/standard", {"> 0"});
   expect_set_rejected({"acceptance.0.justification=\"\""}, "/acceptance/0/justification",
                       {"a non-empty string"});

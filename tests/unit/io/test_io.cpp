@@ -1,6 +1,7 @@
 // Unit tests of the io module: atomic writes and run status of the run directory, the
 // manifest environment, series.h5 round trip, snapshots.h5 + .xdmf layout (dimension order,
-// x-fastest storage, padding of 2D vectors), and the checks that must reject bad input.
+// x-fastest storage, padding of 2D vectors), checkpoints, resuming and comparing runs, and the
+// checks that must reject bad input.
 #include <H5Cpp.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -13,6 +14,8 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "io/checkpoint.hpp"
+#include "io/compare_runs.hpp"
 #include "io/manifest.hpp"
 #include "io/run_directory.hpp"
 #include "io/series_writer.hpp"
@@ -441,6 +444,155 @@ TEST_F(IoSnapshot, Layout2DIsOneLayerInZWithPaddedVectors) {
   if (tool_available("xmllint")) {
     EXPECT_EQ(std::system(("xmllint --noout " + xdmf.string()).c_str()), 0);
   }
+}
+
+
+// ---------------------------------------------------------------- checkpoints and resuming
+
+class IoCheckpoint : public IoTest {};
+
+/// A class with state, as the solver's classes write it: one function saves and restores.
+struct State {
+  std::vector<double> grows;
+  std::array<float, 3> fixed{};
+  std::int32_t counter = 0;
+  long step = 0;
+  bool flag = false;
+  std::string text;
+  template <class Archive>
+  void checkpoint(Archive& ar) {
+    ar("a/grows", grows);
+    ar("a/b/fixed", std::span<float>(fixed));
+    ar("counter", counter);
+    ar("step", step);
+    ar("flag", flag);
+    ar("text", text);
+  }
+};
+
+TEST_F(IoCheckpoint, RoundTripIsExact) {
+  State s{{1.0 / 3.0, -0.0, 1e-300}, {1.5f, 2.5f, 1e-30f}, -7, 123456789012L, true, "{\"x\": 1}"};
+  {
+    CheckpointWriter w(dir_ / "c.h5");
+    s.checkpoint(w);
+    w.close();
+    EXPECT_GT(w.file_bytes(), 0u);
+  }
+  State r;
+  CheckpointReader in(dir_ / "c.h5");
+  r.checkpoint(in);
+  EXPECT_EQ(r.grows, s.grows);
+  EXPECT_EQ(r.fixed, s.fixed);
+  EXPECT_EQ(r.counter, -7);
+  EXPECT_EQ(r.step, 123456789012L);
+  EXPECT_TRUE(r.flag);
+  EXPECT_EQ(r.text, s.text);
+  EXPECT_TRUE(in.contains("a/b/fixed"));
+  EXPECT_FALSE(in.contains("a/c/fixed"));
+  EXPECT_FALSE(in.contains("nothing"));
+}
+
+TEST_F(IoCheckpoint, ReaderRefusesMissingEntriesAndOtherSizesOrTypes) {
+  {
+    CheckpointWriter w(dir_ / "c.h5");
+    std::vector<double> v{1, 2, 3};
+    w("v", v);
+  }
+  CheckpointReader in(dir_ / "c.h5");
+  std::array<double, 2> two{};
+  EXPECT_THROW(in("v", std::span<double>(two)), core::Error);
+  std::vector<float> other;
+  EXPECT_THROW(in("v", other), core::Error);
+  double missing = 0;
+  try {
+    in("w", missing);
+    FAIL() << "a missing entry must be refused";
+  } catch (const core::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'w'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(CheckpointReader(dir_ / "absent.h5"), core::Error);
+}
+
+TEST_F(IoSnapshot, ReopenDropsTheStepsAfterTheIndexAndContinues) {
+  const fs::path h5 = dir_ / "snapshots.h5.partial", xdmf = dir_ / "snapshots.xdmf";
+  const int n = 8;
+  std::vector<Vec<2>> ring;
+  for (int p = 0; p < n; ++p) ring.emplace_back(std::cos(2 * M_PI * p / n), std::sin(2 * M_PI * p / n));
+  const auto segments = closed_ring_segments(n);
+  nlohmann::json index;
+  {
+    SnapshotWriter<2> w(h5, xdmf, "snapshots.h5");
+    w.add_mesh_step(0.0, "capsule", ring, segments);
+    w.add_mesh_step(1.0, "capsule", ring, segments);
+    index = w.index();  // the checkpoint is taken here
+    w.add_mesh_step(2.0, "capsule", ring, segments);  // written by the process that is then killed
+  }
+  {
+    auto w = SnapshotWriter<2>::reopen(h5, xdmf, "snapshots.h5", index);
+    EXPECT_EQ(w.steps(), 2u);
+    w.add_mesh_step(2.0, "capsule", ring, segments);
+    w.add_mesh_step(3.0, "capsule", ring, segments);
+    EXPECT_EQ(w.steps(), 4u);
+  }
+  const std::string xml = read_text(xdmf);
+  EXPECT_TRUE(tags_balanced(xml));
+  EXPECT_NE(xml.find("step_000003"), std::string::npos);
+  H5::H5File f(h5.string(), H5F_ACC_RDONLY);
+  EXPECT_EQ(f.getNumObjs(), 4u);
+  EXPECT_THROW(SnapshotWriter<2>::reopen(dir_ / "absent.h5", xdmf, "snapshots.h5", index), core::Error);
+}
+
+TEST_F(IoRunDirectory, ResumeTakesOnlyAnInterruptedRunWithACheckpoint) {
+  auto expect_refused = [](const fs::path& d, const std::string& why) {
+    try {
+      RunDirectory::resume(d);
+      FAIL() << "resume of " << d << " must be refused";
+    } catch (const core::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  };
+  expect_refused(dir_ / "nothing", "not a caplab run directory");
+  {
+    auto run = RunDirectory::create(dir_ / "killed", false);  // status "running": killed
+  }
+  expect_refused(dir_ / "killed", "before it wrote a checkpoint");
+  write_file_atomically(dir_ / "killed" / "checkpoint.h5", "x");
+  {
+    auto run = RunDirectory::resume(dir_ / "killed");
+    EXPECT_EQ(run.manifest()["status"], "running");
+    EXPECT_EQ(run.manifest()["resumed"].size(), 1u);
+    run.finish("ok");
+  }
+  expect_refused(dir_ / "killed", "finished ok");
+  for (const char* status : {"diverged", "input_error"}) {
+    auto run = RunDirectory::create(dir_ / status, false);
+    write_file_atomically(dir_ / status / "checkpoint.h5", "x");
+    run.finish(status);
+    expect_refused(dir_ / status, status == std::string("diverged") ? "diverge again" : "fix the case");
+  }
+}
+
+TEST_F(IoRunDirectory, CompareRunsFindsEveryDifference) {
+  auto make = [&](const std::string& name, double x, const std::string& mode) {
+    const fs::path d = dir_ / name;
+    fs::create_directories(d);
+    {
+      SeriesWriter s(d / "series.h5", {{"t", "L/U", "time"}, {"x", "1", "value"}});
+      for (int k = 0; k < 3; ++k) s.append(std::vector<double>{double(k), k == 2 ? x : 1.0});
+      s.close();
+    }
+    write_file_atomically(d / "summary.json", nlohmann::json{{"metrics", {{"x", {{"value", x}}}, {"mode", mode}}}}.dump());
+    return d;
+  };
+  const auto a = make("a", 1.0, "steady"), b = make("b", 1.0, "steady"), c = make("c", 1.0 + 1e-14, "steady"),
+             d = make("d", 1.0, "tumbling");
+  EXPECT_TRUE(compare_runs(a, b).identical());
+  const auto ac = compare_runs(a, c);
+  EXPECT_FALSE(ac.identical());
+  EXPECT_EQ(ac.differing, 2u);  // the series value and the summary value
+  EXPECT_NEAR(ac.max_relative, 1e-14, 1e-15);
+  EXPECT_TRUE(compare_runs(a, c, 1e-12).problems.empty());
+  EXPECT_FALSE(compare_runs(a, d, 1.0).problems.empty());  // strings compare exactly
 }
 
 }  // namespace

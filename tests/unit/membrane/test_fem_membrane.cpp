@@ -458,5 +458,33 @@ TEST(FemMembrane, LawNames) {
   EXPECT_EQ(law_name(Skalak{1.0, 5.0}), "Skalak (C = 5)");
 }
 
+// The guards of a run read the worst element: a healthy sphere, a compressed element, a fold.
+TEST(FemMembrane, HealthFindsTheSmallestAndTheFoldedElement) {
+  const auto mesh = octasphere(3);
+  const FemMembrane m(mesh, NeoHookean{1.0});
+  const auto ok = m.health(mesh.nodes);
+  EXPECT_NEAR(ok.min_ratio, 1.0, 1e-12);
+  EXPECT_EQ(ok.folded, -1);
+  // Mirror one corner of a triangle across its opposite edge: that triangle turns over.
+  const auto& t = mesh.triangles[17];
+  auto X = mesh.nodes;
+  X[t[0]] = X[t[1]] + X[t[2]] - X[t[0]];
+  const auto fold = m.health(X);
+  ASSERT_GE(fold.folded, 0);
+  const auto& f = mesh.triangles[static_cast<std::size_t>(fold.folded)];
+  EXPECT_TRUE(f[0] == t[0] || f[1] == t[0] || f[2] == t[0]);
+  // A node pushed deep inward makes a dimple, which is not a fold.
+  X = mesh.nodes;
+  X[5] *= 0.6;
+  EXPECT_EQ(m.health(X).folded, -1);
+  EXPECT_LT(fold.min_ratio, 1.0);
+  EXPECT_GT(fold.max_ratio, 1.0);
+  // A uniform shrink to 0.9 of the radius: every element at 0.81 of its area, nothing folded.
+  for (auto& x : X = mesh.nodes) x *= 0.9;
+  const auto shrunk = m.health(X);
+  EXPECT_NEAR(shrunk.min_ratio, 0.81, 1e-12);
+  EXPECT_EQ(shrunk.folded, -1);
+}
+
 }  // namespace
 }  // namespace caplab::membrane

@@ -292,5 +292,27 @@ TEST(RingMembrane, RejectsBadInput) {
   EXPECT_THROW(ring.energy(std::vector<Vec<2>>(15)), core::Error);
 }
 
+// The guards of a run read the worst segment: a healthy ring, a compressed segment, a fold.
+TEST(RingMembrane, HealthFindsTheShortestAndTheFoldedSegment) {
+  RingShape biconcave{RingShape::Type::biconcave};
+  const auto rest = geometry::ring_nodes(biconcave, Vec<2>(0, 0), 1.0, 0.0, 64);
+  const RingMembrane ring(rest, 1.0, 0.0, ReferenceCurvature::initial);
+  const auto ok = ring.health(rest);  // the dimples bend the contour but fold nothing
+  EXPECT_NEAR(ok.min_ratio, 1.0, 1e-12);
+  EXPECT_NEAR(ok.max_ratio, 1.0, 1e-12);
+  EXPECT_EQ(ok.folded, -1);
+  auto X = rest;
+  X[10] = 0.8 * X[10] + 0.2 * X[11];  // segment 10 shrinks to 0.8 of its length
+  const auto short_segment = ring.health(X);
+  EXPECT_EQ(short_segment.worst, 10u);
+  EXPECT_NEAR(short_segment.min_ratio, 0.8, 0.02);
+  EXPECT_EQ(short_segment.folded, -1);
+  X = rest;
+  std::swap(X[20], X[21]);  // segment 20 now runs backwards
+  const auto fold = ring.health(X);
+  EXPECT_EQ(fold.folded, 20);
+  EXPECT_LT((fold.folded_at - 0.5 * (rest[20] + rest[21])).norm(), 1e-12);
+}
+
 }  // namespace
 }  // namespace caplab::membrane

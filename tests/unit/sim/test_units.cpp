@@ -1,0 +1,140 @@
+// Lattice units of a case: the memory estimate (populations in two buffers, force density,
+// forced-node bookkeeping, snapshot scratch), the refusal of cases that do not fit in the
+// machine's memory, and the refusal of runs whose step count no integer holds.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "../../fuzz/fuzz_input.hpp"
+#include "case/load_case.hpp"
+#include "core/error.hpp"
+#include "sim/units.hpp"
+
+namespace caplab::sim {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path source_dir{CAPLAB_SOURCE_DIR};
+const fs::path cylinder_file = source_dir / "catalogue/ch2/cylinder_re100.json";
+const fs::path sphere_file = source_dir / "catalogue/ch5/sphere_nh_G0.05.json";
+constexpr double gib = 1024.0 * 1024.0 * 1024.0;
+
+double with_ghosts(const BlockUnits& b) {
+  double n = 1;
+  for (int k : b.nodes) n *= k + 2;
+  return n;
+}
+
+TEST(sim_units, MemoryEstimateCountsWhatScalesWithTheLattice) {
+  const auto spec = cases::load_case(cylinder_file, "standard");  // 2D, double, one fixed body, snapshots
+  const auto u = derive_units(spec);
+  ASSERT_EQ(u.blocks.size(), 2u);
+  const double nc = with_ghosts(u.blocks[0]), nf = with_ghosts(u.blocks[1]);
+  const double populations = (nc + nf) * 2 * 9 * 8;
+  const double force = nf * 2 * 8, bookkeeping = nf * 8;
+  const double snapshot = std::max(nc, nf) * 8 * (1 + 2 + 1 + 1);
+  EXPECT_DOUBLE_EQ(u.memory_bytes, populations + force + bookkeeping + snapshot);
+
+  // Single precision halves the populations; no snapshots, no snapshot scratch.
+  const auto single = cases::load_case(cylinder_file, "standard",
+                                       {"numerics.precision=single", "outputs.snapshots.times=[]"});
+  EXPECT_DOUBLE_EQ(derive_units(single).memory_bytes, populations / 2 + force + bookkeeping);
+
+  // 3D: Q = 19 and three force components.
+  const auto sphere = cases::load_case(sphere_file, "standard", {"outputs.snapshots.times=[]"});
+  const auto u3 = derive_units(sphere);
+  const double nc3 = with_ghosts(u3.blocks[0]), nf3 = with_ghosts(u3.blocks[1]);
+  EXPECT_DOUBLE_EQ(u3.memory_bytes, (nc3 + nf3) * 2 * 19 * 4 + nf3 * (3 * 8 + 8));
+}
+
+TEST(sim_units, CasesThatDoNotFitInMemoryAreRefusedNamingTheValueTheMachineAndTheFix) {
+  const auto spec = cases::load_case(cylinder_file, "standard");
+  const auto u = derive_units(spec);
+  EXPECT_NO_THROW(check_memory(spec, u, 1024 * gib));
+  EXPECT_NO_THROW(check_memory(spec, u, 0));  // unknown machine: nothing to compare with
+  try {
+    check_memory(spec, u, 0.5 * gib);
+    ADD_FAILURE() << "a case of " << u.memory_bytes << " bytes fits in 0.5 GiB";
+  } catch (const core::InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.json_path(), "/numerics/grid/fine_spacing");
+    for (const std::string w :
+         {"cylinder_re100.json", "0.02", "GiB of memory", "memory of this machine: 0.5 GiB",
+          "coarser resolution", "smaller domain", "\"single\""})
+      EXPECT_NE(what.find(w), std::string::npos) << "no \"" << w << "\" in: " << what;
+  }
+  // The margin: 10 % of the machine, at least 512 MiB.
+  EXPECT_DOUBLE_EQ(usable_memory_bytes(100 * gib), 90 * gib);
+  EXPECT_DOUBLE_EQ(usable_memory_bytes(2 * gib), 1.5 * gib);
+  // Just above and just below the usable memory.
+  const double machine = (u.memory_bytes + memory_margin_bytes) * 1.001;
+  EXPECT_NO_THROW(check_memory(spec, u, machine));
+  EXPECT_THROW(check_memory(spec, u, u.memory_bytes * 1.05), core::InputError);
+}
+
+TEST(sim_units, ThisMachineHasMemory) { EXPECT_GT(machine_memory_bytes(), 64.0 * 1024 * 1024); }
+
+TEST(sim_units, RunsLongerThanAnyStepCounterAreRefused) {
+  // 1e300 L/U is a valid number of the format, but not a number of steps (the cast to an integer
+  // would be undefined behaviour).
+  const auto spec = cases::load_case(cylinder_file, "standard", {"numerics.end_time=1e300"});
+  try {
+    derive_units(spec);
+    ADD_FAILURE() << "accepted";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.json_path(), "/numerics/end_time");
+    EXPECT_NE(std::string(e.what()).find("at most 1e+11 coarse time steps"), std::string::npos) << e.what();
+  }
+}
+
+// Found by tests/fuzz/fuzz_case.cpp: Re = 1e-320 is a valid positive number, but 1/Re overflows
+// to infinity and the relaxation time with it; a run shorter than one step has no steps.
+TEST(sim_units, ReynoldsNumbersWhoseViscosityOverflowsAndRunsShorterThanAStepAreRefused) {
+  const auto tiny_re = cases::load_case(cylinder_file, "standard", {"physics.reynolds=1e-320"});
+  try {
+    derive_units(tiny_re);
+    ADD_FAILURE() << "accepted";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.json_path(), "/physics/reynolds");
+    EXPECT_NE(std::string(e.what()).find("a finite tau > 0.5"), std::string::npos) << e.what();
+  }
+  const auto short_run =
+      cases::load_case(cylinder_file, "standard",
+                       {"numerics.end_time=1e-300", "outputs.snapshots.times=[]", "outputs.average_from=0"});
+  try {
+    derive_units(short_run);
+    ADD_FAILURE() << "accepted";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.json_path(), "/numerics/end_time");
+    EXPECT_NE(std::string(e.what()).find("at least one coarse time step"), std::string::npos) << e.what();
+  }
+}
+
+// Every input in tests/fuzz/regressions/ (the format of tests/fuzz/fuzz_case.cpp) was once
+// accepted or crashed; each must now be refused with an InputError by load or derive_units.
+TEST(sim_units, FuzzRegressionsAreInputErrors) {
+  int replayed = 0;
+  for (const auto& entry : fs::directory_iterator(source_dir / "tests/fuzz/regressions")) {
+    std::ifstream in(entry.path(), std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const fuzz::FuzzInput input = fuzz::split_fuzz_input(bytes);
+    SCOPED_TRACE(entry.path().filename().string());
+    EXPECT_THROW(
+        {
+          const auto spec = input.overrides.empty()
+                                ? cases::load_case_text(input.text, "fuzz.json")
+                                : cases::load_case(source_dir / fuzz::base_case_files()[input.base],
+                                                   "standard", input.overrides);
+          derive_units(spec);
+        },
+        core::InputError);
+    ++replayed;
+  }
+  EXPECT_GE(replayed, 2);
+}
+
+}  // namespace
+}  // namespace caplab::sim
