@@ -4,6 +4,7 @@ Output (``out``):
     index.html, index.pdf            every chapter's verdicts, environment
     chapterN/index.html, index.pdf   one chapter: cases, figures, scorecards, tables 2.1/2.2 (ch2),
                                      capsule families, thesis statements, verification (capsule.py),
+                                     3D capsules (capsule3d.py: chapter 5; capsule3d_modes.py: chapter 6),
                                      moving bodies: statements, twins, validation (moving.py)
     references.html                  provenance of every reference dataset, with anchors
 
@@ -25,7 +26,7 @@ from pathlib import Path
 
 import jinja2
 
-from . import capsule, capsule3d, cylinder, figures, moving
+from . import capsule, capsule3d, capsule3d_modes, cylinder, figures, moving
 from .references import KIND_LABELS, ReferenceLibrary, claim_summary, parameters_text
 from .runs import (Run, catalogue_cases, chapter_slug, chapter_sort_key, chapter_title, discover,
                    finite, with_missing)
@@ -334,6 +335,10 @@ def build_report(results: Path, out: Path, references: Path | None = None, catal
             for ds in capsules3d.datasets:
                 used[ds.anchor] = ds
             result.problems += [f"{chapter}: {p}" for p in capsules3d.problems]
+            modes3d = capsule3d_modes.build(chapter_runs, refs, chapter, claims=capsules.claims)
+            for ds in modes3d.datasets:
+                used[ds.anchor] = ds
+            result.problems += [f"{chapter}: {p}" for p in modes3d.problems]
             motions = moving.build(chapter_runs, refs, chapter)
             for ds in motions.datasets:
                 used[ds.anchor] = ds
@@ -355,7 +360,7 @@ def build_report(results: Path, out: Path, references: Path | None = None, catal
                 title=f"caplab report — {chapter_title(chapter)}", chapter=chapter,
                 chapter_title=chapter_title(chapter), runs=chapter_runs, views=views, counts=counts(chapter_runs),
                 tables=tables, capsules=capsules, moving=motions, datasets=sorted(used.values(), key=lambda d: d.rel),
-                capsules3d=capsules3d,
+                capsules3d=capsules3d, modes3d=modes3d,
                 conventions=conventions,
                 builds=builds,
                 env_rows=env_rows, meta=meta, cost_figure=figures.cost_vs_error(chapter_runs),

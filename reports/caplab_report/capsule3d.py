@@ -867,22 +867,32 @@ def _histories(title: str, members: list[Run], cache: dict, figs: str) -> Histor
         "(provenance.json note); they are judged on the thesis statements above."))
 
 
-def shape_histories(runs: list[Run], cache: dict) -> list[Histories]:
+#: The thesis figures of chapter 5 that show the histories of each rest shape (shape_histories).
+CH5_HISTORY_FIGURES = {"oblate_spheroid": "figs. 5.15 (10:9) and 5.16 (2:1)",
+                       "biconcave_discoid": "figs. 5.17 (θ) and 5.19 (length and width)"}
+
+
+def group_title(shape: str, ratio, law: str) -> str:
+    """"ZT oblate spheroids, axis ratio 1.5:1", "SK biconcave discoids", "NH spheres"."""
+    if shape == "oblate_spheroid":
+        return f"{LAW_LABELS.get(law, law)} oblate spheroids" + (f", axis ratio {ratio:.3g}:1" if finite(ratio) else "")
+    return f"{LAW_LABELS.get(law, law)} {SHAPE_LABELS.get(shape, shape or '?')}s"
+
+
+def shape_histories(runs: list[Run], cache: dict, figures_of=None) -> list[Histories]:
+    """D, θ/π and the semi-axes against k t, one figure per rest shape, axis ratio and law.
+    ``figures_of(shape, ratio, law)`` names the thesis figures to compare with, or None to leave
+    the group out (default: chapter 5's oblate spheroids and biconcave discoids)."""
+    figures_of = figures_of or (lambda shape, ratio, law: CH5_HISTORY_FIGURES.get(shape))
     groups: dict[tuple, list[Run]] = {}
     for run in runs:
         p = params(run)
-        if p["shape"] in ("oblate_spheroid", "biconcave_discoid") and moving.series(run, cache):
+        if figures_of(p["shape"], p.get("aspect_ratio"), p["law"]) and moving.series(run, cache):
             groups.setdefault((p["shape"], p.get("aspect_ratio"), p["law"]), []).append(run)
     out = []
     for (shape, ratio, law), members in sorted(groups.items(), key=lambda kv: str(kv[0])):
         members.sort(key=lambda r: (params(r)["capillary"] or 0, r.fidelity))
-        if shape == "oblate_spheroid":
-            what = f"{LAW_LABELS.get(law, law)} oblate spheroids" + (f", axis ratio {ratio:.3g}:1" if finite(ratio) else "")
-            figs = "figs. 5.15 (10:9) and 5.16 (2:1)"
-        else:
-            what = f"{LAW_LABELS.get(law, law)} biconcave discoids"
-            figs = "figs. 5.17 (θ) and 5.19 (length and width)"
-        out.append(_histories(what, members, cache, figs))
+        out.append(_histories(group_title(shape, ratio, law), members, cache, figures_of(shape, ratio, law)))
     return out
 
 
@@ -933,6 +943,12 @@ class Capsules3D:
         return [ds for ds in self.provenance if ds.filename != CLAIMS_FILE]
 
 
+def discrepancy_notes(provenance: dict, parts: dict) -> dict:
+    """part -> [(key, entry)] of the provenance.json ``discrepancies`` that ``parts`` names per part."""
+    notes = provenance.get("discrepancies") if isinstance(provenance.get("discrepancies"), dict) else {}
+    return {part: [(k, notes[k]) for k in keys if isinstance(notes.get(k), dict)] for part, keys in parts.items()}
+
+
 def _guarded(section: Capsules3D, what: str, fn, default=None):
     try:
         return fn()
@@ -953,9 +969,7 @@ def build(runs: list[Run], refs: ReferenceLibrary, chapter: str) -> Capsules3D:
         return section
     prov = refs.benchmarks.get(BENCHMARK, {})
     section.conventions = prov.get("conventions") if isinstance(prov.get("conventions"), dict) else {}
-    notes = prov.get("discrepancies") if isinstance(prov.get("discrepancies"), dict) else {}
-    section.discrepancies = {part: [(k, notes[k]) for k in keys if isinstance(notes.get(k), dict)]
-                             for part, keys in DISCREPANCIES.items()}
+    section.discrepancies = discrepancy_notes(prov, DISCREPANCIES)
     if not prov:
         section.problems.append(f"3D capsules: references/{BENCHMARK}/provenance.json not found: no reference data shown")
     ok = section.runs

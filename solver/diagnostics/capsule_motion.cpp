@@ -86,7 +86,12 @@ CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const
   m.inclination_amplitude = 0.5 * (*hi - *lo);
   m.inclination_reversals = reversals(inclination.subspan(first), 2 * oscillation_threshold);
   const double span = t[last] - t[first];
-  if (m.inclination_turn > std::numbers::pi) {
+  // Tumbling: the inclination turns through more than pi in the window, or it did over the run
+  // and is still turning one way (a window shorter than a half-turn). A capsule that tumbled at
+  // first and swings in the window (the intermittent start near the transition, thesis fig.
+  // 6.10 and 6.16) is swinging.
+  if (2 * m.inclination_amplitude > std::numbers::pi ||
+      (m.inclination_turn > std::numbers::pi && m.inclination_reversals == 0)) {
     m.mode = "tumbling";
     const Turns turns = whole_turns(t, inclination, first, std::numbers::pi);
     const double turn = std::abs(inclination[last] - inclination[first]);

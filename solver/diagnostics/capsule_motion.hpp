@@ -8,8 +8,12 @@
 // contour, so its mean rate over a window shorter than a revolution is biased.
 //
 // Classification (times in 1/k):
-//   tumbling                   the inclination turns through more than pi over the run (the
-//                              thesis: "the oscillation amplitude is larger than pi", ch. 3.2.2);
+//   tumbling                   the inclination turns through more than pi in t >= t_from (the
+//                              thesis: "the oscillation amplitude is larger than pi", ch. 3.2.2),
+//                              or over the run while it still turns one way in the window (no
+//                              reversal: a window shorter than a half-turn); a capsule that
+//                              tumbled at first and swings in the window (the intermittent start
+//                              near the transition, thesis figs. 6.10, 6.16) is not tumbling;
 //   oscillating_tank_treading  otherwise, when theta reverses its direction in t >= t_from by
 //                              more than twice `oscillation_threshold` (default 1 degree, so a
 //                              swing of 2 degrees peak to peak): a monotone approach to the
@@ -38,6 +42,12 @@ class AngleUnwrapper {
   /// Forgets the history: the next value is taken as it is (e.g. while a shape is too round
   /// for its axis to mean anything).
   void reset() { started_ = false; }
+  /// The history (io/checkpoint.hpp archive).
+  template <class Archive>
+  void checkpoint(Archive& ar, const std::string& prefix) {
+    ar(prefix + "last", last_);
+    ar(prefix + "started", started_);
+  }
 
  private:
   double period_;

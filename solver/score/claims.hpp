@@ -12,10 +12,12 @@
 // first membrane body, with the case-file defaults where a key is absent:
 //   shape (shape.type), capillary, bending_ratio (0), reference_curvature ("initial"; a circle
 //   with "circle" counts as "initial"), reynolds (physics.reynolds), angle (0),
-//   aspect_ratio (2, ellipses only), alpha (1.39, biconcave shapes only).
+//   aspect_ratio (2 for ellipses; oblate spheroids: as given), alpha (1.39, biconcave shapes
+//   only), law (membrane.law), area_dilation (membrane.area_dilation, Skalak only).
 //
 // Which runs a claim is about. Every key of the claim's "parameters" among shape,
-// aspect_ratio, alpha, reference_curvature, capillary, bending_ratio, reynolds must match
+// aspect_ratio, alpha, reference_curvature, capillary, bending_ratio, reynolds, law,
+// area_dilation must match
 // (other keys are ignored; reference_curvature is ignored for a run with bending_ratio 0): a
 // number within rel 1e-6 / abs 1e-12, a string exactly, {"from", "to"} inclusive (±1e-12),
 // an array as any of its elements. A key the claim does not give is free (the parameter a
@@ -32,7 +34,8 @@
 //            oscillating_tank_treading) accepts either tank-treading mode, any other side
 //            accepts "tumbling";
 //   trend    compare_trend, tolerance 0, in each series of runs that share every parameter
-//            above except "varying", the fidelity and numerics.grid.fine_spacing.
+//            above except "varying" and area_dilation, the fidelity and
+//            numerics.grid.fine_spacing.
 //            "direction": increasing / decreasing (strict; for "metric": "mode", the regimes
 //            ordered steady_tank_treading < oscillating_tank_treading < tumbling, non-strict),
 //            "sequence" (non-decreasing), "approaches" with a numeric "limit" (|v − limit|

@@ -25,6 +25,7 @@ struct Capsule {
   std::string shape = "circle";
   double capillary = 0.04, bending_ratio = 0.0, reynolds = 0.05;
   std::string curvature = "initial";
+  json extra_shape = json::object(), extra_membrane = json::object();  // e.g. aspect_ratio; law, area_dilation
 };
 
 class ScoreClaims : public ::testing::Test {
@@ -44,12 +45,12 @@ class ScoreClaims : public ::testing::Test {
                const json& acceptance = json::array()) {
     const fs::path d = dir_ / fidelity / name;
     fs::create_directories(d);
-    const json body = {{"name", "capsule"},
-                       {"shape", {{"type", c.shape}, {"diameter", 2.0}}},
-                       {"membrane",
-                        {{"capillary", c.capillary},
-                         {"bending_ratio", c.bending_ratio},
-                         {"reference_curvature", c.curvature}}}};
+    json body = {{"name", "capsule"},
+                 {"shape", {{"type", c.shape}, {"diameter", 2.0}}},
+                 {"membrane",
+                  {{"capillary", c.capillary}, {"bending_ratio", c.bending_ratio}, {"reference_curvature", c.curvature}}}};
+    body["shape"].update(c.extra_shape);
+    body["membrane"].update(c.extra_membrane);
     const json case_doc = {{"id", "t/" + name},
                            {"physics", {{"reynolds", c.reynolds}, {"bodies", {body}}}},
                            {"numerics", {{"grid", {{"fine_spacing", 0.05}}}}},
@@ -337,6 +338,41 @@ TEST_F(ScoreClaims, RunsAndClaimsFileProblems) {
   EXPECT_THROW(evaluate_claims(claims({}), {dir_ / "absent"}), core::InputError);
   EXPECT_THROW(evaluate_claims(dir_ / "absent.json", {}), core::InputError);
   EXPECT_EQ(claims_exit_code(json::object(), true), 1);
+}
+
+// 3D capsules (chapter 6): the law and the oblate aspect ratio select runs and split trend series;
+// the area dilation selects runs but does not split a sweep over G (the biconcave cells take C from G).
+TEST_F(ScoreClaims, LawAspectRatioAndAreaDilationOf3DCapsules) {
+  auto oblate = [](double g, double r, const std::string& law, double C = 0) {
+    Capsule c;
+    c.shape = "oblate_spheroid";
+    c.capillary = g;
+    c.reynolds = 0.025;
+    c.extra_shape = {{"aspect_ratio", r}};
+    c.extra_membrane = {{"law", law}};
+    if (C > 0) c.extra_membrane["area_dilation"] = C;
+    return c;
+  };
+  const std::vector<fs::path> runs{run("zt_a", oblate(0.05, 1.5, "zero_thickness"), {{"inclination_amplitude", 0.2}}),
+                                   run("zt_b", oblate(0.2, 1.5, "zero_thickness"), {{"inclination_amplitude", 0.1}}),
+                                   run("zt_c", oblate(0.2, 2.0, "zero_thickness"), {{"inclination_amplitude", 0.5}}),
+                                   run("sk_a", oblate(0.05, 1.5, "skalak", 10), {{"inclination_amplitude", 0.1}}),
+                                   run("sk_b", oblate(0.2, 1.5, "skalak", 100), {{"inclination_amplitude", 0.05}})};
+  const json amplitude = {{"id", "t.amplitude"},          {"kind", "trend"},
+                          {"parameters", {{"shape", "oblate_spheroid"}, {"law", "zero_thickness"}}},
+                          {"metric", "inclination_amplitude"},
+                          {"varying", "capillary"},        {"direction", "decreasing"}};
+  const json zt = check(amplitude, runs);
+  EXPECT_EQ(zt["verdict"], "consistent") << zt.dump(2);
+  EXPECT_EQ(zt["runs"].size(), 3u);    // the law selects; the SK runs are not about it
+  EXPECT_EQ(zt["series"].size(), 2u);  // the aspect ratio splits: 1.5 (two runs) and 2 (one)
+  json sk = amplitude;
+  sk["parameters"]["law"] = "skalak";
+  const json sk_any_C = check(sk, runs);
+  EXPECT_EQ(sk_any_C["verdict"], "consistent") << sk_any_C.dump(2);  // one series although C differs
+  EXPECT_EQ(sk_any_C["series"].size(), 1u);
+  sk["parameters"]["area_dilation"] = 100;
+  EXPECT_EQ(check(sk, runs)["runs"].size(), 1u);
 }
 
 }  // namespace

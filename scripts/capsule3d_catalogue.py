@@ -1,0 +1,97 @@
+"""The layout shared by the generated 3D capsule catalogues (scripts/generate-ch5-cases and
+scripts/generate-ch6-cases): one function builds a case file from the physical parameters,
+with the fidelity levels every 3D capsule case has. Imported by those scripts only.
+
+Conventions (references/capsule3d/provenance.json): L = a (equivalent radius), velocity k a,
+time 1/k, Re = rho k a^2 / mu (thesis section 5.3), G = mu k a / E with the E of eq. 5.1-5.3,
+shear u = (k z, 0, 0): x-z is the shear plane.
+"""
+import math
+
+SERIES = ["taylor_deformation", "inclination", "length", "width", "thickness", "volume_change",
+          "surface_area_change", "max_area_change", "tank_treading_phase"]
+
+
+def fmt(x):
+    return f"{x:g}"
+
+
+def lattice_velocity(re, fine_per_a, tau_f):
+    """k a in lattice units that puts the fine block at relaxation time tau_f:
+    nu_f = (tau_f - 1/2)/3 = U a_f / Re with a_f = a / dx_f."""
+    return round((tau_f - 0.5) / 3 * re / fine_per_a, 6)
+
+
+def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, fine, fine_per_a, subdivisions,
+         end_time, average_from, walls=False, C=None, refinement="two_level", tau_f=3.5,
+         acceptance=(), quick_end=None, snapshots=(), quick_speedup=2):
+    u = lattice_velocity(re, fine_per_a, tau_f)
+    membrane = {"law": law, "capillary": G, "subdivisions": subdivisions}
+    if C is not None:
+        membrane["area_dilation"] = C
+    grid = {"refinement": refinement, "fine_spacing": round(1.0 / fine_per_a, 10)}
+    if refinement == "two_level":
+        grid["fine_region"] = {"min": [fine[0]] * 3, "max": [fine[1]] * 3}
+    size = list(domain) if isinstance(domain, (list, tuple)) else [domain] * 3
+    doc = {
+        "id": f"{chapter}/{cid}",
+        "title": title,
+        "description": description + (
+            f" Lattice: fine spacing a/{fine_per_a}, k a = {u:g} in lattice units (tau_f = {tau_f}, TRT), "
+            f"{4 ** subdivisions * 8} triangles, single-precision populations (measured on the NH sphere at G = 0.05: "
+            "the same steady D as double precision to 1e-6, 13 % less run time at quick; level thesis: double). Quick: half the resolution (a/{fine_per_a // 2}, "
+            f"{4 ** (subdivisions - 1) * 8} triangles) and "
+            + ("twice the lattice velocity (same tau_f)." if quick_speedup == 2 else
+               "the same lattice velocity (the walls' Mach number stays below 0.25; tau_f closer to 1/2)."
+               if quick_speedup == 1 else
+               f"{quick_speedup:g} times the lattice velocity (the membrane's lattice modulus bounds the time step).")),
+        "physics": {
+            "dimension": 3,
+            "flow": {"type": "shear"},
+            "reynolds": re,
+            "domain": {"size": size,
+                       "boundaries": ["periodic", "periodic", "wall"] if walls else ["far_field"] * 3},
+            "bodies": [{"name": "capsule",
+                        "shape": dict(shape, center=[x / 2 for x in size], diameter=2),
+                        "membrane": membrane}],
+        },
+        "numerics": {
+            "grid": grid,
+            "collision": {"operator": "trt"},
+            "precision": "single",
+            "ib": {"kernel": "cosine4"},
+            "lattice_velocity": u,
+            "end_time": end_time,
+        },
+        "fidelity": {
+            "quick": {"numerics.grid.fine_spacing": round(2.0 / fine_per_a, 10),
+                      "numerics.lattice_velocity": round(quick_speedup * u, 8),
+                      "physics.bodies.0.membrane.subdivisions": subdivisions - 1,
+                      **({"numerics.end_time": quick_end} if quick_end else {})},
+            "standard": {},
+            "thesis": {"numerics.precision": "double"},
+        },
+        "outputs": {
+            "series": {"interval": 0.05, "quantities": SERIES},
+            # t = 0: the rest mesh (XDMF, with the fluid's initial state).
+            "snapshots": {"times": [0] + (list(snapshots) or [end_time]), "fields": ["velocity", "vorticity"]},
+            "average_from": average_from,
+        },
+        "acceptance": list(acceptance),
+    }
+    if quick_end:
+        doc["fidelity"]["quick"]["outputs.snapshots.times"] = [0, quick_end]
+    # The fine block's faces lie on coarse nodes: at the quick level's coarser grid, widen the
+    # block to the nearest ones outside (only grid20, at a/5, needs it).
+    coarse_quick = 4.0 / fine_per_a
+    snapped = fine and (math.floor(fine[0] / coarse_quick + 1e-9) * coarse_quick,
+                        math.ceil(fine[1] / coarse_quick - 1e-9) * coarse_quick)
+    if refinement == "two_level" and any(abs(a - b) > 1e-9 for a, b in zip(snapped, fine)):
+        doc["fidelity"]["quick"]["numerics.grid.fine_region.min"] = [round(snapped[0], 10)] * 3
+        doc["fidelity"]["quick"]["numerics.grid.fine_region.max"] = [round(snapped[1], 10)] * 3
+    return doc
+
+
+def tol(quick, standard):
+    """A tolerance per fidelity level (thesis: as standard)."""
+    return {"quick": quick, "standard": standard, "thesis": standard}
