@@ -46,8 +46,8 @@ report:
 bench: build
 	@$(CAPLAB) bench --out reports/out/bench
 
-stress:
-	@echo "make stress: not yet (issue 'Numerical stability and robustness')"; exit 1
+stress: build
+	@scripts/stress --caplab $(CAPLAB) --out reports/out/stress
 
 clean:
 	rm -rf $(BUILD) $(RESULTS) reports/out

@@ -11,7 +11,10 @@ base64 PNG) plus a PDF of each page printed by headless Chromium:
   (cylinder.py); for capsule cases (capsule.py) the families overlaid like the thesis figures,
   Jeffery's orbit, membrane contours, the thesis statements checked against the runs, and
   self-convergence;
-- ``OUT/references.html``: the provenance of every reference dataset, with anchors.
+- ``OUT/references.html``: the provenance of every reference dataset, with anchors;
+- ``reports/out/stress/index.html`` (+ PDF): the stability maps of ``make stress``, built by
+  stress.py (classification, references, boundaries) and stress_theory.py (the explicit-coupling
+  limit) from the stress.json that scripts/stress writes.
 
 Runs that failed, diverged, never finished or are missing are shown as such, never omitted.
 Entry point: ``scripts/report`` (``python -m caplab_report`` with ``reports/`` on the path).

@@ -5,7 +5,8 @@ figure, how obtained, uncertainty, columns, and per row or per dataset a ``kind`
 ``analytic`` reference solutions (formulas with their source) and ``not_available`` notes (data a
 thesis figure is compared with that caplab does not have). A dataset is a CSV, or a JSON file of
 thesis statements ``{"claims": [{"id", "section", "figure", "sentence", "kind", ...}]}`` (format in
-references/capsule2d/provenance.json). A case names a reference as
+references/capsule2d/provenance.json), or, with ``"format": "sweeps"`` in its provenance entry, the
+parameter sweeps of ``make stress`` (references/stress/sweeps.json). A case names a reference as
 ``references/<benchmark>/<file>.csv#<key>`` where the key is ``<row>:<column>`` (row matched
 against the first column, e.g. ``Present:cd_re100``) or ``<t column>:<value column>`` for a
 reference series, as ``references/<benchmark>/claims.json#<claim id>``, as
@@ -138,7 +139,9 @@ class ReferenceLibrary:
                 ds = Dataset(bench_dir.name, path.name, path, described.get(path.name, {}))
                 if not ds.provenance:
                     self.problems.append(f"{ds.rel}: no entry in provenance.json")
-                if path.suffix == ".json":
+                if path.suffix == ".json" and ds.provenance.get("format") == "sweeps":
+                    pass  # a sweep definition (references/stress/sweeps.json, scripts/stress), not claims
+                elif path.suffix == ".json":
                     self._read_claims(ds)
                 else:
                     try:
