@@ -520,12 +520,20 @@ class Scene {
     });
   }
 
+  /// Whether the membrane of `c` has blown up: an element stretched 3 times its rest size,
+  /// collapsed below numerics.guards.min_area_ratio, or folded.
+  bool blown_up(const Capsule<D>& c) const {
+    const auto h = c.membrane().health(c.positions());
+    return !(h.max_ratio < 3.0) || !(h.min_ratio > spec_.numerics.guards.min_area_ratio) || h.folded >= 0;
+  }
+
   /// The likely cause of a membrane that has blown up, with the state of its elements.
   static std::string diverged_membrane(const Capsule<D>& c) {
     const auto h = c.membrane().health(c.positions());
     return fmt::format("the membrane nodes diverged (elements at {:.3g} to {:.3g} times their rest size{}): the "
                        "explicit membrane-fluid coupling is too stiff for the time step, which happens at small "
-                       "capillary numbers G; lower numerics.lattice_velocity (a smaller time step) or refine the grid",
+                       "capillary numbers G; lower numerics.lattice_velocity (a smaller time step; at a fixed Reynolds "
+                       "number the membrane's lattice modulus falls as its square)",
                        h.min_ratio, h.max_ratio, h.folded >= 0 ? ", folded" : "");
   }
 
@@ -539,10 +547,8 @@ class Scene {
     } catch (const core::NumericalError&) {
       throw;
     } catch (const core::Error& e) {
-      const auto h = c.membrane().health(c.positions());
-      const bool exploded = !(h.max_ratio < 3.0) || !(h.min_ratio > spec_.numerics.guards.min_area_ratio) || h.folded >= 0;
       throw core::NumericalError(step_, fmt::format("immersed boundary of capsule '{}'", c.name()), e.what(),
-                                 exploded ? diverged_membrane(c)
+                                 blown_up(c) ? diverged_membrane(c)
                                           : "the capsule left the fine block with a healthy membrane: enlarge the fine "
                                             "region (numerics.grid.fine_region) or move the capsule away from its edge");
     }
@@ -735,6 +741,33 @@ class Scene {
     return integrate([](double rho, const Vec<D>&) { return rho; });
   }
 
+  /// The likely cause of a flow that left the guards' range: a membrane that blew up first (the
+  /// usual case with capsules: make stress measures the explicit-coupling limit), tau close to
+  /// 1/2, or a lattice velocity too high for the Reynolds number.
+  std::string flow_divergence_cause(double tau) const {
+    for (const auto& c : capsules_)
+      if (blown_up(c)) return fmt::format("capsule '{}' first: {}", c.name(), diverged_membrane(c));
+    // The explicit-coupling limit measured by make stress: E_lu = nu_lu U_lu / G of about 5 (2D), 2 (3D).
+    const double limit = D == 2 ? 5.0 : 2.0;
+    for (const auto& b : spec_.physics.bodies)
+      if (b.membrane) {
+        const double E_lu = units_.blocks.back().nu_lu * units_.velocity_lu / b.membrane->capillary;
+        if (E_lu > limit)
+          return fmt::format("the membrane of '{}' is too stiff for the time step: its lattice modulus E_lu = nu U / G "
+                             "= {:.3g} is above the explicit-coupling limit measured by make stress (about {:g} in "
+                             "{}D); lower numerics.lattice_velocity (E_lu grows as its square; a finer grid at the same "
+                             "lattice velocity raises it)",
+                             b.name, E_lu, limit, D);
+      }
+    if (tau < 0.55)
+      return fmt::format("tau = {:.4f} on this block is close to 1/2 for this Reynolds number and grid; use the TRT "
+                         "operator, refine the grid or lower numerics.lattice_velocity",
+                         tau);
+    return fmt::format("the lattice velocity {:.3g} is too high for this flow (compressibility): lower "
+                       "numerics.lattice_velocity",
+                       units_.velocity_lu);
+  }
+
   static std::string position_text(const Vec<D>& x) {
     std::string pos = fmt::format("{:.4g}", x[0]);
     for (int a = 1; a < D; ++a) pos += fmt::format(", {:.4g}", x[a]);
@@ -753,7 +786,8 @@ class Scene {
       std::string problem;
       Index<D> where{};
       field::for_each_interior<D>(grid, [&](const Index<D>& ijk) {
-        if (!problem.empty()) return;
+        // Coarse nodes under the fine block only mirror it (restriction): the fine node is checked.
+        if (!problem.empty() || (b == 0 && fluid_.two_level() && fluid_.coupling().covered(ijk))) return;
         const auto m = collision::node_moments<L, T>(blk.pop, grid.index(ijk));
         double u2 = 0;
         for (int a = 0; a < D; ++a) u2 += m.u[a] * m.u[a];
@@ -770,10 +804,7 @@ class Scene {
       if (!problem.empty())
         throw core::NumericalError(
             step, fmt::format("{} block, node at ({}) L", units_.blocks[b].name, position_text(grid.position(where))),
-            problem,
-            fmt::format("tau = {:.4f} on this block is close to 1/2 or the lattice velocity {:.3g} is too high for "
-                        "this Reynolds number; use the TRT operator, refine the grid or lower numerics.lattice_velocity",
-                        units_.blocks[b].tau, units_.velocity_lu));
+            problem, flow_divergence_cause(units_.blocks[b].tau));
     }
     for (std::size_t c = 0; c < capsules_.size(); ++c) {
       const auto& cap = capsules_[c];
@@ -795,7 +826,7 @@ class Scene {
                               position_text(h.folded_at)),
             fmt::format("the {} is folded over its neighbours (inverted)", element),
             "either the explicit coupling is too stiff for the time step (a small capillary number G: lower "
-            "numerics.lattice_velocity or refine the grid), or the membrane buckles or wrinkles below what its mesh "
+            "numerics.lattice_velocity), or the membrane buckles or wrinkles below what its mesh "
             "resolves (the thesis reports wrinkles in long runs: a finer membrane or bending stiffness)");
       if (!(h.min_ratio >= g.min_area_ratio))
         throw core::NumericalError(
