@@ -49,6 +49,18 @@ int check(const CheckArgs& args) {
   } catch (const core::InputError& e) {  // the case is valid; it only does not fit on this machine
     fmt::print("  warning: `caplab run` refuses this case on this machine: {}\n", e.what());
   }
+  for (const auto& b : spec.physics.bodies)
+    if (b.membrane) {
+      const double E_lu = sim::membrane_lattice_modulus(u, b);
+      const double limit = sim::membrane_stiffness_limit(spec.physics.dimension);
+      fmt::print("  membrane '{}': lattice modulus E_lu = nu U / G = {:.3g} (the explicit-coupling limit make stress "
+                 "measured without bending stiffness is about {:g}; bending stiffness lowers it)\n",
+                 b.name, E_lu, limit);
+      if (E_lu > limit)
+        fmt::print("  warning: the membrane of '{}' is likely too stiff for this time step and will blow up; lower "
+                   "numerics.lattice_velocity (E_lu grows as its square)\n",
+                   b.name);
+    }
   fmt::print("  estimated run time: {} at 50 MLUPS, {} at 150 MLUPS\n", human_seconds(u.estimated_seconds(50)),
              human_seconds(u.estimated_seconds(150)));
   fmt::print("ok: {} is valid at fidelity {}\n", args.case_file.string(), spec.fidelity);

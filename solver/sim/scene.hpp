@@ -747,11 +747,10 @@ class Scene {
   std::string flow_divergence_cause(double tau) const {
     for (const auto& c : capsules_)
       if (blown_up(c)) return fmt::format("capsule '{}' first: {}", c.name(), diverged_membrane(c));
-    // The explicit-coupling limit measured by make stress: E_lu = nu_lu U_lu / G of about 5 (2D), 2 (3D).
-    const double limit = D == 2 ? 5.0 : 2.0;
+    const double limit = membrane_stiffness_limit(D);
     for (const auto& b : spec_.physics.bodies)
       if (b.membrane) {
-        const double E_lu = units_.blocks.back().nu_lu * units_.velocity_lu / b.membrane->capillary;
+        const double E_lu = membrane_lattice_modulus(units_, b);
         if (E_lu > limit)
           return fmt::format("the membrane of '{}' is too stiff for the time step: its lattice modulus E_lu = nu U / G "
                              "= {:.3g} is above the explicit-coupling limit measured by make stress (about {:g} in "

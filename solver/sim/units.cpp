@@ -227,4 +227,8 @@ nlohmann::json LatticeUnits::to_json() const {
   return j;
 }
 
+double membrane_lattice_modulus(const LatticeUnits& units, const cases::BodySpec& body) {
+  return units.blocks.back().nu_lu * units.velocity_lu / body.membrane->capillary;
+}
+
 }  // namespace caplab::sim

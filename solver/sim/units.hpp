@@ -71,6 +71,16 @@ double usable_memory_bytes(double machine_bytes);
 /// Called before anything is allocated or written; does nothing when machine_bytes is 0.
 void check_memory(const cases::CaseSpec& spec, const LatticeUnits& units, double machine_bytes);
 
+/// The explicit membrane-fluid coupling is stable while a membrane's modulus in lattice units
+/// of the finest block, E_lu = nu_lu U_lu / G, stays below about this (measured by make stress:
+/// the 2D boundary at 5-6.7 on every line of the G x U maps, the 3D NH sphere at 2-4). Without
+/// bending stiffness: bending adds its own limit (the E_b x U map), so a stiff-bending
+/// membrane can blow up below it.
+inline double membrane_stiffness_limit(int dimension) { return dimension == 2 ? 5.0 : 2.0; }
+
+/// E_lu = nu_lu U_lu / G of a capsule body (the finest block's viscosity).
+double membrane_lattice_modulus(const LatticeUnits& units, const cases::BodySpec& body);
+
 /// Imposed (unperturbed) velocity of the case's flow at position x (in L), in units of U.
 std::vector<double> imposed_velocity(const cases::CaseSpec& spec, const std::vector<double>& x);
 
