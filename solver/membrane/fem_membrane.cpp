@@ -102,6 +102,8 @@ FemMembrane::FemMembrane(const geometry::TriangleMesh& rest, MembraneLaw law)
   for (std::size_t e = 0; e < ne; ++e)
     for (int k = 0; k < 3; ++k) node_corners_[fill[triangles_[e][k]]++] = static_cast<int>(3 * e + k);
   corner_forces_.resize(3 * ne);
+  element_normals_.resize(ne);
+  node_normals_.resize(node_count());
 }
 
 void FemMembrane::check_size(const char* what, std::size_t size, std::size_t expected) const {
@@ -199,7 +201,10 @@ ElementHealth<3> FemMembrane::health(std::span<const Vec<3>> X) const {
   ElementHealth<3> h;
   h.min_ratio = std::numeric_limits<double>::infinity();
   h.max_ratio = 0;
-  std::vector<Vec<3>> normal(triangles_.size()), around(node_count(), Vec<3>::Zero());
+  // Scratch sized at construction: the guards call this during the run (no allocation there).
+  std::vector<Vec<3>>& normal = element_normals_;
+  std::vector<Vec<3>>& around = node_normals_;
+  std::fill(around.begin(), around.end(), Vec<3>::Zero());
   for (std::size_t e = 0; e < triangles_.size(); ++e) {
     const auto& t = triangles_[e];
     normal[e] = 0.5 * (X[t[1]] - X[t[0]]).cross(X[t[2]] - X[t[0]]);  // area-weighted

@@ -158,6 +158,8 @@ class FemMembrane final : public Membrane<3> {
   std::vector<int> node_corners_;
   // Scratch of forces(): the force of element e on its corner k at 3 e + k.
   mutable std::vector<Vec<3>> corner_forces_;
+  // Scratch of health(): area-weighted element normals and their sums around each node.
+  mutable std::vector<Vec<3>> element_normals_, node_normals_;
 };
 
 }  // namespace caplab::membrane
