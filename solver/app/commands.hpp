@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench.hpp"
+
 namespace caplab::app {
 
 struct RunArgs {
@@ -38,6 +40,7 @@ struct CompareArgs {
 struct BenchArgs {
   std::filesystem::path out;
   bool quick = false;
+  bench::BenchOptions options;  // sizes, threads, lattices, ... (zero or empty: the defaults)
 };
 
 int run(const RunArgs& args, bool terminal);

@@ -76,6 +76,13 @@ int main(int argc, char** argv) {
   auto* bench_cmd = app.add_subcommand("bench", "Measure memory bandwidth and fluid MLUPS (roofline)");
   bench_cmd->add_option("--out", bench.out, "Output directory")->default_val("reports/out/bench");
   bench_cmd->add_flag("--quick", bench.quick, "Small sizes and short timings (smoke test)");
+  bench_cmd->add_option("--threads", bench.options.threads, "Thread counts to measure, e.g. 1,2")->delimiter(',');
+  bench_cmd->add_option("--size-d2q9", bench.options.size_d2q9, "Edge of the D2Q9 box (default 2048, quick 256)");
+  bench_cmd->add_option("--size-d3q19", bench.options.size_d3q19, "Edge of the D3Q19 box (default 128, quick 32)");
+  bench_cmd->add_option("--lattices", bench.options.lattices, "D2Q9,D3Q19")->delimiter(',');
+  bench_cmd->add_option("--collisions", bench.options.collisions, "bgk,trt")->delimiter(',');
+  bench_cmd->add_option("--precisions", bench.options.precisions, "double,float")->delimiter(',');
+  bench_cmd->add_option("--min-seconds", bench.options.min_seconds, "Minimum time per fluid measurement");
 
   app::CompareArgs compare;
   auto* compare_cmd = app.add_subcommand(

@@ -25,7 +25,7 @@ int claims(const ClaimsArgs& args) {
 }
 
 int bench(const BenchArgs& args) {
-  bench::BenchOptions opt;
+  bench::BenchOptions opt = args.options;
   opt.quick = args.quick;
   opt.output_dir = args.out;
   bench::run_benchmarks(opt);  // prints its table and writes bench.json

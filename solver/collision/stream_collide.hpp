@@ -11,6 +11,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <span>
 
 #include "collision/equilibrium.hpp"
@@ -46,12 +47,46 @@ inline void collide_forced(const T (&f)[L::q], const T (&F)[L::d], const Op& op,
   op.template collide<L, T>(f, feq, s, out);
 }
 
+/// Nodes per vector chunk of the fused kernel: one 64-byte cache line of one population.
+template <class T>
+inline constexpr int simd_chunk = static_cast<int>(64 / sizeof(T));
+
+/// Collide-and-push of node n (the body of the fused kernel's vector loop). Scalars and
+/// references to C arrays only, so that GCC vectorizes the loop that calls it.
+template <bool Forced, class L, class T, class Op>
+[[gnu::always_inline]] inline void update_node(const T* __restrict src, T* __restrict dst, std::ptrdiff_t N,
+                                               const std::ptrdiff_t (&off)[L::q], const Op& op,
+                                               const double* const (&fp)[L::d], std::ptrdiff_t n) {
+  constexpr int Q = L::q, D = L::d;
+  T f[Q], feq[Q], out[Q], rho, u[D];
+#pragma GCC unroll 19
+  for (int i = 0; i < Q; ++i) f[i] = src[i * N + n];
+  if constexpr (Forced) {
+    T F[D];
+    for (int a = 0; a < D; ++a) F[a] = T(fp[a][n]);
+    collide_forced<L, T>(f, F, op, out);
+  } else {
+    moments<L, T>(f, rho, u);
+    equilibrium<L, T>(rho, u, feq);
+    op.template collide<L, T>(f, feq, out);
+  }
+#pragma GCC unroll 19
+  for (int i = 0; i < Q; ++i) dst[i * N + n + off[i]] = out[i];
+}
+
 /// One time step of the fluid on a block: collide and stream into `next()`, no swap.
 /// `force` (lattice units, per node) must be non-null exactly when Forced is true.
+///
+/// Each row runs in chunks of simd_chunk<T> nodes with a trip count known at compile time, so
+/// the whole row is vector code; the last chunk is shifted back to end at the row's end and
+/// redoes a few nodes, which is harmless: a node's update reads only current() and writes the
+/// same values to next() each time. (A row of 47 nodes, the fine block of a chapter 5 sphere,
+/// otherwise ends in a 15-node scalar remainder: measured 51 MLUPS at 47^3 against 128 at 48^3,
+/// D3Q19 TRT single, 2 threads.)
 template <bool Forced, class L, class T, class Op>
 void stream_collide(field::Populations<L, T>& pop, const Op& op,
                     const field::VectorField<L::d, double>* force = nullptr) {
-  constexpr int Q = L::q, D = L::d;
+  constexpr int Q = L::q, D = L::d, W = simd_chunk<T>;
   const auto& g = pop.grid();
   const std::ptrdiff_t N = g.size();
   std::array<std::ptrdiff_t, Q> off;
@@ -68,27 +103,20 @@ void stream_collide(field::Populations<L, T>& pop, const Op& op,
     const T* __restrict src_l = src;
     T* __restrict dst_l = dst;
     const std::ptrdiff_t N_l = N;
-    const auto off_l = off;
+    std::ptrdiff_t off_l[Q];
+    for (int i = 0; i < Q; ++i) off_l[i] = off[i];
     const Op op_l = op;
     const double* fp_l[D];
     for (int a = 0; a < D; ++a) fp_l[a] = fp[a];
+    if (nx < W) {
 #pragma omp simd
-    for (int x = 0; x < nx; ++x) {
-      const std::ptrdiff_t n = base + x;
-      T f[Q], feq[Q], out[Q], rho, u[D];
-#pragma GCC unroll 19
-      for (int i = 0; i < Q; ++i) f[i] = src_l[i * N_l + n];
-      if constexpr (Forced) {
-        T F[D];
-        for (int a = 0; a < D; ++a) F[a] = T(fp_l[a][n]);
-        collide_forced<L, T>(f, F, op_l, out);
-      } else {
-        moments<L, T>(f, rho, u);
-        equilibrium<L, T>(rho, u, feq);
-        op_l.template collide<L, T>(f, feq, out);
-      }
-#pragma GCC unroll 19
-      for (int i = 0; i < Q; ++i) dst_l[i * N_l + n + off_l[i]] = out[i];
+      for (int x = 0; x < nx; ++x) update_node<Forced, L, T>(src_l, dst_l, N_l, off_l, op_l, fp_l, base + x);
+      return;
+    }
+    for (int x0 = 0; x0 < nx; x0 += W) {
+      const std::ptrdiff_t chunk = base + std::min(x0, nx - W);
+#pragma omp simd
+      for (int x = 0; x < W; ++x) update_node<Forced, L, T>(src_l, dst_l, N_l, off_l, op_l, fp_l, chunk + x);
     }
   });
 }
