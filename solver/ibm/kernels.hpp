@@ -1,8 +1,10 @@
 // Regularised delta functions of the immersed-boundary method (1D factors).
 //
-// Each kernel is a policy: `support` is the number of grid nodes per axis that it touches
-// and `phi(r)` the 1D weight at the distance r (in grid spacings) between a node and a
-// marker. The D-dimensional kernel is the tensor product phi(x) phi(y) [phi(z)]
+// Each kernel is a policy: `support` is the number of grid nodes per axis that it touches,
+// `phi(r)` the 1D weight at the distance r (in grid spacings) between a node and a marker,
+// and `weights(d, w)` the support weights w[s] = phi(d - s) of the stencil whose first node
+// lies d behind the marker (what the transfer computes per marker and axis; the cosine
+// kernel gets all four from one sincos). The D-dimensional kernel is the tensor product phi(x) phi(y) [phi(z)]
 // (thesis eq. 2.18 / 5.9). Kernels are even, vanish for |r| >= support / 2 and have unit
 // integral.
 //
@@ -37,7 +39,22 @@ struct Cosine4 {
     const double a = std::abs(r);
     return a < 2.0 ? 0.25 * (1.0 + std::cos(0.5 * std::numbers::pi * a)) : 0.0;
   }
+  /// d in [1, 2]: cos(pi (d - s)/2) for s = 0..3 is c, s, -c, -s with (s, c) = sincos(pi d/2).
+  static void weights(double d, double (&w)[support]) {
+    const double theta = 0.5 * std::numbers::pi * d;
+    const double c = std::cos(theta), s = std::sin(theta);
+    w[0] = 0.25 * (1.0 + c);
+    w[1] = 0.25 * (1.0 + s);
+    w[2] = 0.25 * (1.0 - c);
+    w[3] = 0.25 * (1.0 - s);
+  }
 };
+
+/// weights() of a kernel from its phi(): w[s] = phi(d - s).
+template <class Kernel>
+void weights_from_phi(double d, double (&w)[Kernel::support]) {
+  for (int s = 0; s < Kernel::support; ++s) w[s] = Kernel::phi(d - s);
+}
 
 /// Three-point kernel of Roma, Pope & Kendall 1999:
 /// phi(r) = (1 + sqrt(1 - 3 r^2)) / 3                       for |r| <= 1/2,
@@ -54,6 +71,7 @@ struct Roma3 {
     }
     return 0.0;
   }
+  static void weights(double d, double (&w)[support]) { weights_from_phi<Roma3>(d, w); }
 };
 
 /// Two-point hat kernel phi(r) = 1 - |r| for |r| <= 1, else 0 (multi-linear interpolation).
@@ -64,6 +82,7 @@ struct Linear2 {
     const double a = std::abs(r);
     return a < 1.0 ? 1.0 - a : 0.0;
   }
+  static void weights(double d, double (&w)[support]) { weights_from_phi<Linear2>(d, w); }
 };
 
 }  // namespace caplab::ibm

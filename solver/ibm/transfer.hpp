@@ -19,10 +19,14 @@
 //     so the time loop does not allocate once the marker count is stable.
 //   * Threads: update() and interpolation run in parallel over markers (OpenMP, for large
 //     marker counts); the callables passed to interpolate must be safe to call
-//     concurrently and must not throw. Spreading is serial on purpose: markers are few
-//     compared with fluid nodes (a 3D capsule: ~16k markers x 64 nodes), neighbouring
-//     stencils overlap, and a serial loop is race-free and bit-reproducible without
-//     colouring.
+//     concurrently and must not throw. Spreading runs in parallel over slabs: update()
+//     sorts the markers (stably) by the slab of `support` nodes along the last axis in
+//     which their stencil starts. A node is reached from at most two consecutive slabs, so
+//     the even slabs can spread at once, then the odd ones; each node then sums its
+//     contributions in the same order (even slab, then odd, markers in index order within
+//     a slab) whatever the thread count: bit-reproducible without locks. Along a periodic
+//     last axis a stencil may wrap onto the first slab, and the spread is serial in the
+//     same order.
 #pragma once
 
 #include <array>
@@ -83,6 +87,7 @@ class Transfer {
     if (first_bad < m_count)
       core::check_failed("stencil inside block", __FILE__, __LINE__,
                          stencil_error(first_bad, positions[first_bad]));
+    sort_into_slabs();
   }
 
   std::size_t marker_count() const { return x_lu_.size(); }
@@ -117,23 +122,39 @@ class Transfer {
     gather<double>(value_at, out);
   }
 
+  /// Linear grid indices of the stencils of all markers (marker m at [m * stencil_size, ...)).
+  std::span<const std::ptrdiff_t> all_stencil_nodes() const { return {node_.data(), x_lu_.size() * stencil_size}; }
+
   /// f(x) += sum_m force_density[m] weight_lu[m] phi(x - X_m) (eq. 2.16 / 5.8), with the
-  /// force per unit marker measure and the marker measure in lattice units. Serial (see
-  /// the file header).
+  /// force per unit marker measure and the marker measure in lattice units. In parallel over
+  /// slabs, in an order that does not depend on the thread count (see the file header).
   void spread(std::span<const Vec<D>> force_density, std::span<const double> weight_lu,
               field::VectorField<D>& f) const {
     CAPLAB_CHECK(force_density.size() == marker_count() && weight_lu.size() == marker_count(),
                  "IB spread: need one force density and one weight per marker (as in the last update)");
     CAPLAB_CHECK(static_cast<std::ptrdiff_t>(f.comp[0].size()) == grid_.size(),
                  "IB spread: the force field is not sized for the grid of the last update");
-    for (std::size_t m = 0; m < marker_count(); ++m) {
-      const Vec<D> fm = force_density[m] * weight_lu[m];
-      const std::size_t base = m * stencil_size;
-      for (int e = 0; e < stencil_size; ++e) {
-        const std::ptrdiff_t id = node_[base + e];
-        const double w = w_[base + e];
-        for (int a = 0; a < D; ++a) f.comp[a][id] += w * fm[a];
+    auto spread_slab = [&](int slab) {
+      for (std::size_t k = slab_start_[slab]; k < slab_start_[slab + 1]; ++k) {
+        const std::size_t m = order_[k];
+        const Vec<D> fm = force_density[m] * weight_lu[m];
+        const std::size_t base = m * stencil_size;
+        for (int e = 0; e < stencil_size; ++e) {
+          const std::ptrdiff_t id = node_[base + e];
+          const double w = w_[base + e];
+          for (int a = 0; a < D; ++a) f.comp[a][id] += w * fm[a];
+        }
       }
+    };
+    const int slabs = slab_count();
+    if (periodic_[D - 1]) {
+      for (int slab = 0; slab < slabs; ++slab) spread_slab(slab);
+      return;
+    }
+    const bool parallel = static_cast<std::ptrdiff_t>(marker_count()) > detail::parallel_threshold;
+    for (int parity = 0; parity < 2; ++parity) {
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
+      for (int slab = parity; slab < slabs; slab += 2) spread_slab(slab);
     }
   }
 
@@ -163,7 +184,7 @@ class Transfer {
 
   // Fills the stencil of marker m; false if it leaves the interior along a non-periodic axis.
   bool fill_stencil(std::ptrdiff_t m) {
-    std::array<std::array<double, support>, D> w1;
+    double w1[D][support];
     std::array<std::array<int, support>, D> i1;
     for (int a = 0; a < D; ++a) {
       const int n = grid_.n()[a];
@@ -173,9 +194,9 @@ class Transfer {
       const double lo = first_node(x);
       if (!periodic_[a] && (lo < 0.0 || lo + support - 1 > n - 1)) return false;
       const int i0 = static_cast<int>(lo);
+      Kernel::weights(x - i0, w1[a]);
       for (int s = 0; s < support; ++s) {
         const int i = i0 + s;
-        w1[a][s] = Kernel::phi(x - i);
         i1[a][s] = periodic_[a] ? ((i % n) + n) % n : i;
       }
     }
@@ -195,6 +216,28 @@ class Transfer {
       w_[base + e] = w;
     }
     return true;
+  }
+
+  // Slabs of `support` nodes along the last axis; a stencil starting in slab k reaches slab k + 1
+  // at most (support - 1 nodes further), never k + 2.
+  int slab_count() const { return grid_.n()[D - 1] / support + 1; }
+
+  // order_ = the markers sorted stably by the slab of their first stencil node along the last
+  // axis (a counting sort); slab k holds order_[slab_start_[k] .. slab_start_[k + 1]).
+  void sort_into_slabs() {
+    const int slabs = slab_count();
+    const std::size_t m_count = marker_count();
+    slab_start_.assign(slabs + 1, 0);
+    slab_of_.resize(m_count);
+    order_.resize(m_count);
+    for (std::size_t m = 0; m < m_count; ++m) {
+      slab_of_[m] = ijk_[m * stencil_size][D - 1] / support;
+      ++slab_start_[slab_of_[m] + 1];
+    }
+    for (int k = 0; k < slabs; ++k) slab_start_[k + 1] += slab_start_[k];
+    for (std::size_t m = 0; m < m_count; ++m) order_[slab_start_[slab_of_[m]]++] = m;
+    for (int k = slabs; k > 0; --k) slab_start_[k] = slab_start_[k - 1];  // undo the fill's advance
+    slab_start_[0] = 0;
   }
 
   std::string stencil_error(std::ptrdiff_t m, const Vec<D>& x_phys) const {
@@ -238,6 +281,8 @@ class Transfer {
   std::vector<std::ptrdiff_t> node_;
   std::vector<Index<D>> ijk_;
   std::vector<double> w_;
+  std::vector<std::size_t> slab_start_, order_;  // markers by slab (sort_into_slabs)
+  std::vector<int> slab_of_;
 };
 
 /// One-shot interpolation of velocity_at(const Index<D>&, std::ptrdiff_t) -> Vec<D> at the

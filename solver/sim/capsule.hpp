@@ -17,9 +17,9 @@
 // block (so forces come out as lattice forces per unit depth in 2D); F_m is spread with unit
 // weight because it is a node force, not a density per marker measure.
 //
-// Invariants: buffers are sized once at construction (no allocation in the time loop);
-// restore() must run before spread() of the next step (it clears the stencils spread()
-// wrote, see Fluid::ForcingHook).
+// Invariants: buffers are sized once at construction (no allocation in the time loop); the
+// scene sets the nodes of the last stencils back to the uniform body force before spread()
+// of the next step (see Fluid::ForcingHook and Scene::apply_ib).
 #pragma once
 
 #include <memory>
@@ -64,22 +64,9 @@ class Capsule {
   /// Node velocities of the last advect() (lattice units).
   std::span<const Vec<D>> velocities() const { return U_; }
 
-  /// Calls g(linear index) for every node of the stencils of the last spread() (with repeats).
-  template <class G>
-  void for_each_stencil_node(G&& g) const {
-    std::visit(
-        [&](const auto& tr) {
-          for (std::size_t m = 0; m < tr.marker_count(); ++m)
-            for (const auto node : tr.stencil_nodes(m)) g(node);
-        },
-        transfer_);
-  }
-
-  /// Sets the stencil nodes written by the last spread() back to `base` (the uniform body force).
-  void restore(field::VectorField<D>& f, const Vec<D>& base) const {
-    for_each_stencil_node([&](std::ptrdiff_t node) {
-      for (int a = 0; a < D; ++a) f.comp[a][node] = base[a];
-    });
+  /// Linear indices of the nodes of the stencils of the last spread() (with repeats).
+  std::span<const std::ptrdiff_t> stencil_nodes() const {
+    return std::visit([](const auto& tr) { return tr.all_stencil_nodes(); }, transfer_);
   }
 
   /// Step 1: the membrane forces at the current positions.

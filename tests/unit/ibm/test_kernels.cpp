@@ -53,6 +53,18 @@ TYPED_TEST(KernelTest, DiscretePartitionOfUnityIsExact) {
   }
 }
 
+TYPED_TEST(KernelTest, StencilWeightsArePhiAtTheSupportNodes) {
+  // weights(d, w) is what the transfer uses; w[s] = phi(d - s) for the first node d behind.
+  using K = TypeParam;
+  for (int k = 0; k <= 1000; ++k) {
+    const double x = -1.0 + 3.0 * k / 1000;
+    const double i0 = std::floor(x - 0.5 * K::support) + 1.0;
+    double w[K::support];
+    K::weights(x - i0, w);
+    for (int s = 0; s < K::support; ++s) EXPECT_NEAR(w[s], K::phi(x - i0 - s), 2e-16) << "x = " << x << ", s = " << s;
+  }
+}
+
 TEST(Roma3, FirstMomentAndSquaresExact) {
   for (int k = 0; k < 1000; ++k) {
     const double x = k / 1000.0;
