@@ -12,12 +12,18 @@
 //    collided, and pushes into the interior; u_b is the imposed unperturbed flow;
 //  - interface: left to the multi-block coupling (refinement module).
 // All links are precomputed once; applying them touches only the block surface.
+// Far-field ghosts are stored as structure of arrays in memory order and processed in
+// batches: one vector loop over a batch computes all Q post-collision values of each ghost,
+// then a scalar loop writes the links. Every entering slot has exactly one source ghost, so
+// the result does not depend on the order or the batching.
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "collision/equilibrium.hpp"
+#include "core/error.hpp"
 #include "field/populations.hpp"
 
 namespace caplab::boundary {
@@ -34,7 +40,10 @@ class BoundarySet {
 
   BoundarySet() = default;
   BoundarySet(const field::Grid<D>& g, const std::array<Kind, D>& kinds, const VelocityField& imposed) {
+    CAPLAB_CHECK(g.size() <= std::numeric_limits<int>::max(),
+                 "block too large for the far field's 32-bit node indices");
     field::for_each_ghost<D>(g, [&](const Index<D>& h) { add_ghost(g, kinds, imposed, h); });
+    pad_far_field();
   }
 
   /// Fills the interior slots entering from the ghost layer, in pop.next().
@@ -44,45 +53,52 @@ class BoundarySet {
     T* next = pop.next();
     const std::ptrdiff_t N = pop.grid().size();
     for (const auto& c : copies_) next[c.dst] = next[c.src] + T(c.add);
+    const T* current = pop.current();
+    const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(far_interior_.size()) / batch;
 #pragma omp parallel for schedule(static)
-    for (std::size_t k = 0; k < far_.size(); ++k) {
-      const auto& s = far_[k];
-      T post[Q];
-      ghost_post_collision(pop, op, s, post);
-      for (int l = s.first_link; l < s.first_link + s.link_count; ++l)
-        next[far_links_[l].i * N + far_links_[l].dst] = post[far_links_[l].i];
-    }
+    for (std::ptrdiff_t b = 0; b < batches; ++b) far_field_batch(current, next, N, op, b * batch);
   }
 
-  bool empty() const { return copies_.empty() && far_.empty(); }
+  bool empty() const { return copies_.empty() && far_interior_.empty(); }
 
  private:
+  /// Far-field ghosts per vector loop: one 64-byte cache line of T.
+  static constexpr int batch = static_cast<int>(64 / sizeof(T));
+
   struct Copy {
     std::ptrdiff_t dst, src;  // full slot indices i·N + node
     double add;
-  };
-  struct FarNode {
-    std::ptrdiff_t interior;  // nearest interior node (extrapolation source)
-    std::array<double, D> u_b;
-    int first_link, link_count;
   };
   struct Link {
     int i;
     std::ptrdiff_t dst;  // interior node receiving population i
   };
 
+  /// Guo's extrapolation and the collision of ghosts k0 … k0 + batch − 1, then their links.
   template <class Op>
-  static void ghost_post_collision(const field::Populations<L, T>& pop, const Op& op, const FarNode& s,
-                                   T (&post)[Q]) {
-    T f[Q], feq_f[Q], feq_b[Q], fb[Q];
-    for (int i = 0; i < Q; ++i) f[i] = pop(i, s.interior);
-    const auto m = collision::moments<L, T>(f);
-    collision::equilibrium<L, T>(m.rho, m.u, feq_f);
-    std::array<T, D> ub;
-    for (int a = 0; a < D; ++a) ub[a] = T(s.u_b[a]);
-    collision::equilibrium<L, T>(m.rho, ub, feq_b);
-    for (int i = 0; i < Q; ++i) fb[i] = feq_b[i] + (f[i] - feq_f[i]);
-    op.template collide<L, T>(fb, feq_b, post);
+  void far_field_batch(const T* __restrict current, T* __restrict next, std::ptrdiff_t N, const Op& op,
+                       std::ptrdiff_t k0) const {
+    T post[Q][batch];
+#pragma omp simd
+    for (int b = 0; b < batch; ++b) {
+      T f[Q], feq_f[Q], feq_b[Q], fb[Q], out[Q], rho, u[D], ub[D];
+      // A 32-bit node index into population i's array: GCC 12 turns it into a vector gather;
+      // a 64-bit index into the whole buffer leaves the loop scalar.
+#pragma GCC unroll 19
+      for (int i = 0; i < Q; ++i) f[i] = (current + i * N)[far_interior_[k0 + b]];
+      collision::moments<L, T>(f, rho, u);
+      collision::equilibrium<L, T>(rho, u, feq_f);
+      for (int a = 0; a < D; ++a) ub[a] = far_u_b_[a][k0 + b];
+      collision::equilibrium<L, T>(rho, ub, feq_b);
+#pragma GCC unroll 19
+      for (int i = 0; i < Q; ++i) fb[i] = feq_b[i] + (f[i] - feq_f[i]);
+      op.template collide<L, T>(fb, feq_b, out);
+#pragma GCC unroll 19
+      for (int i = 0; i < Q; ++i) post[i][b] = out[i];
+    }
+    for (int b = 0; b < batch; ++b)
+      for (int l = far_first_link_[k0 + b]; l < far_first_link_[k0 + b + 1]; ++l)
+        next[far_links_[l].i * N + far_links_[l].dst] = post[far_links_[l].i][b];
   }
 
   void add_ghost(const field::Grid<D>& g, const std::array<Kind, D>& kinds, const VelocityField& imposed,
@@ -116,19 +132,34 @@ class BoundarySet {
         far_links_.push_back({i, g.index(t)});
       }
     }
-    const int count = static_cast<int>(far_links_.size()) - first;
-    if (owner == Kind::far_field && count > 0) {
+    if (owner == Kind::far_field && static_cast<int>(far_links_.size()) > first) {
       Index<D> inner;
       for (int a = 0; a < D; ++a) inner[a] = std::clamp(h[a], 0, g.n()[a] - 1);
       const Vec<D> u = imposed(g.position(h));
-      FarNode s{g.index(inner), {}, first, count};
-      for (int a = 0; a < D; ++a) s.u_b[a] = u[a];
-      far_.push_back(s);
+      far_interior_.push_back(static_cast<int>(g.index(inner)));
+      for (int a = 0; a < D; ++a) far_u_b_[a].push_back(T(u[a]));
+      far_first_link_.push_back(first);
     }
   }
 
+  /// Fills the last batch with copies of the last ghost that own no links, and closes the
+  /// link ranges.
+  void pad_far_field() {
+    while (!far_interior_.empty() && far_interior_.size() % batch != 0) {
+      far_interior_.push_back(far_interior_.back());
+      for (int a = 0; a < D; ++a) far_u_b_[a].push_back(far_u_b_[a].back());
+      far_first_link_.push_back(static_cast<int>(far_links_.size()));
+    }
+    far_first_link_.push_back(static_cast<int>(far_links_.size()));
+  }
+
   std::vector<Copy> copies_;
-  std::vector<FarNode> far_;
+  // Far-field ghosts in the order of the ghost layer (memory order), padded to whole batches:
+  // nearest interior node (extrapolation source), imposed velocity u_b, and the links of
+  // ghost k, far_links_[far_first_link_[k] … far_first_link_[k + 1]).
+  std::vector<int> far_interior_;
+  std::array<std::vector<T>, D> far_u_b_;
+  std::vector<int> far_first_link_;
   std::vector<Link> far_links_;
 };
 
