@@ -129,22 +129,28 @@ void stream_collide(field::Populations<L, T>& pop, const Op& op,
 template <class L, class T, class Op>
 void collide_forced_at(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>& force,
                        std::span<const std::ptrdiff_t> nodes) {
-  constexpr int Q = L::q, D = L::d;
+  constexpr int Q = L::q, D = L::d, W = simd_chunk<T>;
   const auto& g = pop.grid();
   const std::ptrdiff_t N = g.size();
-  std::array<std::ptrdiff_t, Q> off;
+  std::ptrdiff_t off[Q];
   for (int i = 0; i < Q; ++i) off[i] = g.offset(L::c[i]);
   const T* src = pop.current();
   T* dst = pop.next();
+  const double* fp[D];
+  for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data();
+  const std::ptrdiff_t* node = nodes.data();
   const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(nodes.size());
+  if (count < W) {
+    for (std::ptrdiff_t k = 0; k < count; ++k) update_node<true, L, T>(src, dst, N, off, op, fp, node[k]);
+    return;
+  }
+  // Chunks of W nodes as vector code (gathers and scatters; the nodes are distinct, so no two
+  // lanes write one slot); the last chunk is shifted back, as in stream_collide.
 #pragma omp parallel for schedule(static) if (count > 256)
-  for (std::ptrdiff_t k = 0; k < count; ++k) {
-    const std::ptrdiff_t n = nodes[k];
-    T f[Q], F[D], out[Q];
-    for (int i = 0; i < Q; ++i) f[i] = src[i * N + n];
-    for (int a = 0; a < D; ++a) F[a] = T(force.comp[a][n]);
-    collide_forced<L, T>(f, F, op, out);
-    for (int i = 0; i < Q; ++i) dst[i * N + n + off[i]] = out[i];
+  for (std::ptrdiff_t k0 = 0; k0 < count; k0 += W) {
+    const std::ptrdiff_t* chunk = node + std::min(k0, count - W);
+#pragma omp simd
+    for (int j = 0; j < W; ++j) update_node<true, L, T>(src, dst, N, off, op, fp, chunk[j]);
   }
 }
 
