@@ -121,8 +121,7 @@ void stream_collide(field::Populations<L, T>& pop, const Op& op,
   });
 }
 
-/// Redoes the collide-and-push of the interior nodes `nodes` (linear indices, no repeats
-/// needed) with Guo forcing, after stream_collide<false> of the whole block: every slot of
+/// Redoes the collide-and-push of the interior nodes `nodes` (distinct linear indices) with Guo forcing, after stream_collide<false> of the whole block: every slot of
 /// next() receives from exactly one node, so overwriting the pushes of the forced nodes gives
 /// the forced step there and the unforced one (force zero) elsewhere. This keeps the forced
 /// kernel, about twice the cost per node, to the immersed boundary's stencils.
@@ -144,13 +143,20 @@ void collide_forced_at(field::Populations<L, T>& pop, const Op& op, const field:
     for (std::ptrdiff_t k = 0; k < count; ++k) update_node<true, L, T>(src, dst, N, off, op, fp, node[k]);
     return;
   }
-  // Chunks of W nodes as vector code (gathers and scatters; the nodes are distinct, so no two
-  // lanes write one slot); the last chunk is shifted back, as in stream_collide.
+  // Whole chunks of W nodes as vector code in parallel (gathers and scatters; the nodes are
+  // distinct, so no two lanes write one slot), then the rest as one chunk shifted back to end
+  // at the last node, after the parallel loop: it redoes nodes of the last whole chunk, which
+  // must not run on another thread at the same time.
+  const std::ptrdiff_t whole = count / W * W;
 #pragma omp parallel for schedule(static) if (count > 256)
-  for (std::ptrdiff_t k0 = 0; k0 < count; k0 += W) {
-    const std::ptrdiff_t* chunk = node + std::min(k0, count - W);
+  for (std::ptrdiff_t k0 = 0; k0 < whole; k0 += W) {
 #pragma omp simd
-    for (int j = 0; j < W; ++j) update_node<true, L, T>(src, dst, N, off, op, fp, chunk[j]);
+    for (int j = 0; j < W; ++j) update_node<true, L, T>(src, dst, N, off, op, fp, node[k0 + j]);
+  }
+  if (whole < count) {
+    const std::ptrdiff_t* tail = node + (count - W);
+#pragma omp simd
+    for (int j = 0; j < W; ++j) update_node<true, L, T>(src, dst, N, off, op, fp, tail[j]);
   }
 }
 

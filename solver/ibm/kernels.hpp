@@ -39,7 +39,7 @@ struct Cosine4 {
     const double a = std::abs(r);
     return a < 2.0 ? 0.25 * (1.0 + std::cos(0.5 * std::numbers::pi * a)) : 0.0;
   }
-  /// d in [1, 2]: cos(pi (d - s)/2) for s = 0..3 is c, s, -c, -s with (s, c) = sincos(pi d/2).
+  /// d in [1, 2] (the transfer's first node lies 1 < d <= 2 behind): cos(pi (d - s)/2) for s = 0..3 is c, s, -c, -s with (s, c) = sincos(pi d/2).
   static void weights(double d, double (&w)[support]) {
     const double theta = 0.5 * std::numbers::pi * d;
     const double c = std::cos(theta), s = std::sin(theta);

@@ -25,8 +25,8 @@
 //     the even slabs can spread at once, then the odd ones; each node then sums its
 //     contributions in the same order (even slab, then odd, markers in index order within
 //     a slab) whatever the thread count: bit-reproducible without locks. Along a periodic
-//     last axis a stencil may wrap onto the first slab, and the spread is serial in the
-//     same order.
+//     last axis a stencil may wrap onto the first slab, and the spread is serial, slab by
+//     slab (markers in index order within a slab).
 #pragma once
 
 #include <array>
@@ -227,15 +227,12 @@ class Transfer {
   void sort_into_slabs() {
     const int slabs = slab_count();
     const std::size_t m_count = marker_count();
+    auto slab_of = [&](std::size_t m) { return ijk_[m * stencil_size][D - 1] / support; };
     slab_start_.assign(slabs + 1, 0);
-    slab_of_.resize(m_count);
     order_.resize(m_count);
-    for (std::size_t m = 0; m < m_count; ++m) {
-      slab_of_[m] = ijk_[m * stencil_size][D - 1] / support;
-      ++slab_start_[slab_of_[m] + 1];
-    }
+    for (std::size_t m = 0; m < m_count; ++m) ++slab_start_[slab_of(m) + 1];
     for (int k = 0; k < slabs; ++k) slab_start_[k + 1] += slab_start_[k];
-    for (std::size_t m = 0; m < m_count; ++m) order_[slab_start_[slab_of_[m]]++] = m;
+    for (std::size_t m = 0; m < m_count; ++m) order_[slab_start_[slab_of(m)]++] = m;
     for (int k = slabs; k > 0; --k) slab_start_[k] = slab_start_[k - 1];  // undo the fill's advance
     slab_start_[0] = 0;
   }
@@ -282,7 +279,6 @@ class Transfer {
   std::vector<Index<D>> ijk_;
   std::vector<double> w_;
   std::vector<std::size_t> slab_start_, order_;  // markers by slab (sort_into_slabs)
-  std::vector<int> slab_of_;
 };
 
 /// One-shot interpolation of velocity_at(const Index<D>&, std::ptrdiff_t) -> Vec<D> at the
