@@ -91,9 +91,17 @@ class TwoLevel {
       const T* h2 = &history_[(lev[2] * S + src) * Q];
       for (int i = 0; i < Q; ++i) at_s[src * Q + i] = T(lag[0]) * h0[i] + T(lag[1]) * h1[i] + T(lag[2]) * h2[i];
     }
+    const std::size_t G = ghosts_.size();
 #pragma omp parallel for schedule(static)
-    for (std::size_t k = 0; k < ghosts_.size(); ++k) {
+    for (std::size_t k = 0; k < G; ++k) {
       const auto& gh = ghosts_[k];
+      // The links scatter over the 19 population planes, mostly one cache line each: ask for
+      // the lines of a ghost a few ahead now, so that the writes do not wait on them in turn.
+      if (k + kPrefetchAhead < G) {
+        const auto& ahead = ghosts_[k + kPrefetchAhead];
+        for (int l = ahead.first_link; l < ahead.first_link + ahead.link_count; ++l)
+          __builtin_prefetch(&next[links_[l].i * N + links_[l].dst], 1);
+      }
       T f[Q] = {};
       for (int w = gh.first_weight; w < gh.first_weight + gh.weight_count; ++w) {
         const auto& sw = weights_[w];
@@ -144,6 +152,8 @@ class TwoLevel {
   }
 
  private:
+  static constexpr std::size_t kPrefetchAhead = 4;  // ghosts (fill_fine_ghosts)
+
   struct Weight {
     std::size_t source;  // index into sources_
     double weight;
