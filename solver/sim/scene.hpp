@@ -98,7 +98,7 @@ class Scene {
     const bool resumed = step_ > 0;
     const double dt = units_.blocks[0].dt;
     const long total = units_.coarse_steps;
-    const long sample_every = std::max(1L, std::lround(spec_.outputs.series.interval / dt));
+    const long sample_every = series_sample_every(spec_, units_);
     const long guard_every = spec_.numerics.guards.every;
     std::vector<long> snapshot_steps;
     for (double ts : spec_.outputs.snapshots.times) snapshot_steps.push_back(std::lround(std::ceil(ts / dt - 1e-9)));

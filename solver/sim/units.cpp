@@ -135,6 +135,13 @@ LatticeUnits derive_units(const CaseSpec& spec) {
                     "{:.3g}); shorten the run or coarsen the grid",
                     max_coarse_steps, lu.blocks[0].dt, steps));
   lu.coarse_steps = static_cast<long>(steps);
+  // Checked here, not at the end of the run, where the window statistics would fail after all the work.
+  if (const long rows = series_rows_in_window(spec, lu); rows < min_window_rows)
+    throw core::InputError(
+        spec.source_file, "/outputs/average_from", fmt::format("{}", spec.outputs.average_from),
+        fmt::format("an averaging window holding at least {} rows of the series (this one holds {}: rows every {:.4g} "
+                    "L/U up to end_time {}); lower average_from, raise end_time or shorten outputs.series.interval",
+                    min_window_rows, rows, series_sample_every(spec, lu) * lu.blocks[0].dt, spec.numerics.end_time));
   double per_step = lu.blocks[0].node_count();
   if (two_level) per_step += 2.0 * lu.blocks[1].node_count();
   lu.node_updates = per_step * static_cast<double>(lu.coarse_steps);
@@ -187,6 +194,23 @@ double machine_memory_bytes() {
 
 double usable_memory_bytes(double machine_bytes) {
   return machine_bytes - std::max(memory_margin_share * machine_bytes, memory_margin_bytes);
+}
+
+long series_sample_every(const CaseSpec& spec, const LatticeUnits& units) {
+  return std::max(1L, std::lround(spec.outputs.series.interval / units.blocks[0].dt));
+}
+
+long series_rows_in_window(const CaseSpec& spec, const LatticeUnits& units) {
+  // Rows at steps k·every (k >= 1) and at the last step; a row at step s has t = s·dt.
+  const double dt = units.blocks[0].dt;
+  const long total = units.coarse_steps, every = series_sample_every(spec, units);
+  long first = static_cast<long>(std::ceil(spec.outputs.average_from / dt - 1e-9));  // first step in the window
+  first = std::max(first, 1L);
+  while (first > 1 && (first - 1) * dt >= spec.outputs.average_from) --first;
+  while (first <= total && first * dt < spec.outputs.average_from) ++first;
+  if (first > total) return 0;
+  const long multiples = total / every - (first - 1) / every;  // k·every in [first, total]
+  return multiples + (total % every != 0 ? 1 : 0);
 }
 
 void check_memory(const CaseSpec& spec, const LatticeUnits& units, double machine_bytes) {

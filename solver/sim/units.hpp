@@ -68,6 +68,14 @@ double usable_memory_bytes(double machine_bytes);
 
 /// Throws core::InputError (at /numerics/grid/fine_spacing) when `units.memory_bytes` exceeds
 /// usable_memory_bytes(machine_bytes), naming the estimate, the machine's memory and the fixes.
+/// Coarse steps between two rows of series.h5 (outputs.series.interval rounded to whole steps, at
+/// least one); the run also writes a row at its last step.
+long series_sample_every(const cases::CaseSpec& spec, const LatticeUnits& units);
+/// Rows of series.h5 at or after outputs.average_from: the summary's window statistics (mean,
+/// amplitude, period, mode) need at least min_window_rows of them.
+long series_rows_in_window(const cases::CaseSpec& spec, const LatticeUnits& units);
+inline constexpr long min_window_rows = 3;
+
 /// Called before anything is allocated or written; does nothing when machine_bytes is 0.
 void check_memory(const cases::CaseSpec& spec, const LatticeUnits& units, double machine_bytes);
 

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include "../../fuzz/fuzz_input.hpp"
 #include "case/load_case.hpp"
@@ -111,6 +112,28 @@ TEST(sim_units, ReynoldsNumbersWhoseViscosityOverflowsAndRunsShorterThanAStepAre
     EXPECT_EQ(e.json_path(), "/numerics/end_time");
     EXPECT_NE(std::string(e.what()).find("at least one coarse time step"), std::string::npos) << e.what();
   }
+}
+
+// The summary's window statistics need three series rows after average_from; a shorter window
+// used to fail at the end of the run (exit 4, after all the work). It is refused up front.
+TEST(sim_units, AveragingWindowsWithFewerThanThreeSeriesRowsAreRefused) {
+  const std::vector<std::string> short_window{"numerics.end_time=0.1", "outputs.snapshots.times=[0]",
+                                              "outputs.average_from=0.05"};  // rows every 0.05 L/U
+  try {
+    derive_units(cases::load_case(sphere_file, "standard", short_window));
+    ADD_FAILURE() << "accepted";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.json_path(), "/outputs/average_from");
+    EXPECT_NE(std::string(e.what()).find("this one holds 2"), std::string::npos) << e.what();
+  }
+  const auto ok = cases::load_case(sphere_file, "standard",
+                                   {"numerics.end_time=0.2", "outputs.snapshots.times=[0]", "outputs.average_from=0.1"});
+  const auto units = derive_units(ok);
+  EXPECT_EQ(series_rows_in_window(ok, units), 3);  // t = 0.1, 0.15, 0.2 (to within a step)
+  // The whole run: every row (end_time / interval of them) is in a window from 0.
+  const auto whole = cases::load_case(sphere_file, "standard", {"outputs.average_from=0"});
+  const auto whole_units = derive_units(whole);
+  EXPECT_NEAR(series_rows_in_window(whole, whole_units), whole.numerics.end_time / whole.outputs.series.interval, 1.0);
 }
 
 // Every input in tests/fuzz/regressions/ (the format of tests/fuzz/fuzz_case.cpp) was once
