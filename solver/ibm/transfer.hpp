@@ -19,8 +19,8 @@
 //     so the time loop does not allocate once the marker count is stable.
 //   * Threads: update() and interpolation run in parallel over markers (OpenMP, for large
 //     marker counts); the callables passed to interpolate must be safe to call
-//     concurrently and must not throw. Spreading runs in parallel over slabs: update()
-//     sorts the markers (stably) by the slab of `support` nodes along the last axis in
+//     concurrently and must not throw. Spreading runs in parallel over slabs: spread()
+//     first sorts the markers (stably) by the slab of `support` nodes along the last axis in
 //     which their stencil starts. A node is reached from at most two consecutive slabs, so
 //     the even slabs can spread at once, then the odd ones; each node then sums its
 //     contributions in the same order (even slab, then odd, markers in index order within
@@ -87,7 +87,6 @@ class Transfer {
     if (first_bad < m_count)
       core::check_failed("stencil inside block", __FILE__, __LINE__,
                          stencil_error(first_bad, positions[first_bad]));
-    sort_into_slabs();
   }
 
   std::size_t marker_count() const { return x_lu_.size(); }
@@ -128,12 +127,15 @@ class Transfer {
   /// f(x) += sum_m force_density[m] weight_lu[m] phi(x - X_m) (eq. 2.16 / 5.8), with the
   /// force per unit marker measure and the marker measure in lattice units. In parallel over
   /// slabs, in an order that does not depend on the thread count (see the file header).
+  /// (Not const: it sorts the markers into slabs first, which only spreading needs; direct
+  /// forcing of rigid bodies updates stencils every step but spreads through its own copy.)
   void spread(std::span<const Vec<D>> force_density, std::span<const double> weight_lu,
-              field::VectorField<D>& f) const {
+              field::VectorField<D>& f) {
     CAPLAB_CHECK(force_density.size() == marker_count() && weight_lu.size() == marker_count(),
                  "IB spread: need one force density and one weight per marker (as in the last update)");
     CAPLAB_CHECK(static_cast<std::ptrdiff_t>(f.comp[0].size()) == grid_.size(),
                  "IB spread: the force field is not sized for the grid of the last update");
+    sort_into_slabs();
     auto spread_slab = [&](int slab) {
       for (std::size_t k = slab_start_[slab]; k < slab_start_[slab + 1]; ++k) {
         const std::size_t m = order_[k];

@@ -29,6 +29,17 @@ double with_ghosts(const BlockUnits& b) {
   return n;
 }
 
+// derive_units must refuse `spec` with an InputError at `path` whose message contains `text`.
+void expect_refused(const cases::CaseSpec& spec, const std::string& path, const std::string& text) {
+  try {
+    derive_units(spec);
+    ADD_FAILURE() << "accepted; expected a refusal at " << path;
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.json_path(), path);
+    EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+  }
+}
+
 TEST(sim_units, MemoryEstimateCountsWhatScalesWithTheLattice) {
   const auto spec = cases::load_case(cylinder_file, "standard");  // 2D, double, one fixed body, snapshots
   const auto u = derive_units(spec);
@@ -82,36 +93,18 @@ TEST(sim_units, RunsLongerThanAnyStepCounterAreRefused) {
   // 1e300 L/U is a valid number of the format, but not a number of steps (the cast to an integer
   // would be undefined behaviour).
   const auto spec = cases::load_case(cylinder_file, "standard", {"numerics.end_time=1e300"});
-  try {
-    derive_units(spec);
-    ADD_FAILURE() << "accepted";
-  } catch (const core::InputError& e) {
-    EXPECT_EQ(e.json_path(), "/numerics/end_time");
-    EXPECT_NE(std::string(e.what()).find("at most 1e+11 coarse time steps"), std::string::npos) << e.what();
-  }
+  expect_refused(spec, "/numerics/end_time", "at most 1e+11 coarse time steps");
 }
 
 // Found by tests/fuzz/fuzz_case.cpp: Re = 1e-320 is a valid positive number, but 1/Re overflows
 // to infinity and the relaxation time with it; a run shorter than one step has no steps.
 TEST(sim_units, ReynoldsNumbersWhoseViscosityOverflowsAndRunsShorterThanAStepAreRefused) {
   const auto tiny_re = cases::load_case(cylinder_file, "standard", {"physics.reynolds=1e-320"});
-  try {
-    derive_units(tiny_re);
-    ADD_FAILURE() << "accepted";
-  } catch (const core::InputError& e) {
-    EXPECT_EQ(e.json_path(), "/physics/reynolds");
-    EXPECT_NE(std::string(e.what()).find("a finite tau > 0.5"), std::string::npos) << e.what();
-  }
+  expect_refused(tiny_re, "/physics/reynolds", "a finite tau > 0.5");
   const auto short_run =
       cases::load_case(cylinder_file, "standard",
                        {"numerics.end_time=1e-300", "outputs.snapshots.times=[]", "outputs.average_from=0"});
-  try {
-    derive_units(short_run);
-    ADD_FAILURE() << "accepted";
-  } catch (const core::InputError& e) {
-    EXPECT_EQ(e.json_path(), "/numerics/end_time");
-    EXPECT_NE(std::string(e.what()).find("at least one coarse time step"), std::string::npos) << e.what();
-  }
+  expect_refused(short_run, "/numerics/end_time", "at least one coarse time step");
 }
 
 // The summary's window statistics need three series rows after average_from; a shorter window
@@ -119,13 +112,7 @@ TEST(sim_units, ReynoldsNumbersWhoseViscosityOverflowsAndRunsShorterThanAStepAre
 TEST(sim_units, AveragingWindowsWithFewerThanThreeSeriesRowsAreRefused) {
   const std::vector<std::string> short_window{"numerics.end_time=0.1", "outputs.snapshots.times=[0]",
                                               "outputs.average_from=0.05"};  // rows every 0.05 L/U
-  try {
-    derive_units(cases::load_case(sphere_file, "standard", short_window));
-    ADD_FAILURE() << "accepted";
-  } catch (const core::InputError& e) {
-    EXPECT_EQ(e.json_path(), "/outputs/average_from");
-    EXPECT_NE(std::string(e.what()).find("this one holds 2"), std::string::npos) << e.what();
-  }
+  expect_refused(cases::load_case(sphere_file, "standard", short_window), "/outputs/average_from", "this one holds 2");
   const auto ok = cases::load_case(sphere_file, "standard",
                                    {"numerics.end_time=0.2", "outputs.snapshots.times=[0]", "outputs.average_from=0.1"});
   const auto units = derive_units(ok);
