@@ -40,8 +40,8 @@ reproduce-chapter%: build
 reproduce-extra: build
 	@scripts/reproduce --caplab $(CAPLAB) --fidelity $(or $(FIDELITY),standard) --results $(RESULTS) catalogue/extra
 
-report:
-	@scripts/report --results $(RESULTS)
+report: build
+	@scripts/report --results $(RESULTS) --caplab $(CAPLAB)
 
 bench: build
 	@$(CAPLAB) bench --out reports/out/bench

@@ -12,9 +12,10 @@ convergence checks (DESIGN.md section 7):
   thesis figures (2.17, 3.3, 3.10, 3.12, 3.17, 3.19, 4.4, 4.5): D_xy(kt), theta/pi(kt) and the
   membrane contours of snapshots.h5; ellipse families carry Jeffery's orbit (verification);
 - validation: every thesis statement of the chapter (references/*/claims.json, ids "<chapter>.*")
-  with the runs it is about and a cross-run check of the runs' summary.json against it: a mode,
-  the two sides of a bracket, the direction of a trend, a bound. score.json stays the per-run
-  verdict; this check only says whether the runs together agree with the statement;
+  with the runs it is about and the verdict of ``caplab claims`` on them (claims.py; the checks
+  are the C++ scorer's, solver/score/claims.hpp): a mode, the two sides of a bracket, the
+  direction of a trend, a bound. score.json stays the per-run verdict; this check only says
+  whether the runs together agree with the statement;
 - verification: tumbling periods against Jeffery's half-turn period, and self-convergence (one
   case on several grids, the finest as the self-reference, as thesis figs. 2.18 and 4.3) and
   domain-size series;
@@ -27,6 +28,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import matplotlib
 
@@ -35,12 +37,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from . import figures  # noqa: E402
-from .references import PARAMETER_SYMBOLS, ReferenceLibrary, claim_modes, claim_summary, parameters_text  # noqa: E402
+from . import claims as claims_tool  # noqa: E402
+from .references import PARAMETER_SYMBOLS, ReferenceLibrary, claim_summary, parameters_text  # noqa: E402
 from .runs import Run, finite  # noqa: E402
 
 SERIES = ("taylor_deformation", "inclination", "area_change", "tank_treading_phase")
-#: Order of the regimes along the stages of thesis section 3.2.2 (more bending, less shear).
-MODE_ORDER = {"steady_tank_treading": 0, "oscillating_tank_treading": 1, "tumbling": 2}
 TANK_TREADING = ("steady_tank_treading", "oscillating_tank_treading")
 #: Capsule parameters in the keys of the claims (references/capsule2d/provenance.json format).
 KEYS = ("shape", "aspect_ratio", "alpha", "reference_curvature", "capillary", "bending_ratio", "reynolds", "law")
@@ -185,20 +186,6 @@ def acceptance_problems(case: dict, refs: ReferenceLibrary) -> list[str]:
     return problems
 
 
-def _statistic(run: Run, claim: dict, cache: dict):
-    """The number a trend or bound claim is about, for one run (None when unavailable)."""
-    metric = claim.get("metric")
-    if not metric:
-        return None
-    if claim.get("statistic") in ("max", "min"):
-        series = capsule_series(run, cache).get(metric)
-        if series is None or not np.isfinite(series[1]).any():
-            return None
-        return float(np.nanmax(series[1]) if claim["statistic"] == "max" else np.nanmin(series[1]))
-    v = run.summary_value(metric)
-    return float(v) if finite(v) else None
-
-
 @dataclass
 class ClaimRun:
     label: str
@@ -229,139 +216,63 @@ class ClaimCheck:
 
 def _parameters_text(params: dict) -> str:
     parts = [f"G = {params['capillary']:g}" if finite(params.get("capillary")) else "G = ?",
-             f"E_b = {params['bending_ratio']:g}"]
+             f"E_b = {params.get('bending_ratio') or 0:g}"]
     if finite(params.get("reynolds")):
         parts.append(f"Re = {params['reynolds']:g}")
     return ", ".join(parts)
 
 
-def _scored_verdict(run: Run, claim_id: str) -> str:
-    entry = references_claim(run, claim_id)
-    if entry is None:
-        return ""
-    for e in run.entries:
-        if e.get("metric") == entry.get("metric"):
-            return str(e.get("verdict") or "")
-    return "not scored"
-
-
-def check_claim(claim: dict, runs: list[Run], cache: dict | None = None) -> ClaimCheck:
-    """Confronts one thesis statement with the capsule runs it is about (see the module doc)."""
-    cache = {} if cache is None else cache
-    cid = claim.get("id", "")
-    check = ClaimCheck(claim, claim_summary(claim), parameters_text(claim.get("parameters")))
-    kind = claim.get("kind")
-    varying = claim.get("varying")
-    chosen: list[tuple[Run, dict]] = []
-    problems = []
-    for run in runs:
-        params = parameters(run)
-        wrong = claim_matches(claim, params)
-        named = references_claim(run, cid) is not None
-        if named and wrong:
-            problems.append(f"{run.case_id} names this claim in its acceptance, but " + "; ".join(wrong))
-        if not wrong or named:
-            chosen.append((run, params))
-    ok_runs = [(r, p) for r, p in chosen if r.status == "ok"]
-
-    def row(run, params, value, ok=None):
-        check.runs.append(ClaimRun(f"{run.case_id} ({run.fidelity})", run.anchor, value, ok, _scored_verdict(run, cid),
-                                   _parameters_text(params)))
-
-    for run, params in chosen:
-        if run.status != "ok":
-            row(run, params, f"run {run.status_label.lower()}")
-    if kind == "mode":
-        modes = claim_modes(claim)
-        for run, params in ok_runs:
-            mode = mode_of(run)
-            ok = mode in modes and not claim_matches(claim, params)
-            row(run, params, mode or "no mode in summary.json", ok)
-    elif kind == "bracket":
-        lo, hi = (claim.get("between") or [math.nan, math.nan])[:2]
-        below, above = claim.get("below"), claim.get("above")
-        for run, params in ok_runs:
-            x, mode = params.get(varying), mode_of(run)
-            side = below if finite(x) and x <= lo else above if finite(x) and x >= hi else None
-            if side is None:
-                row(run, params, f"{mode} (inside the bracket)")
-            else:
-                same = (mode in TANK_TREADING) == (side in TANK_TREADING) if mode else False
-                row(run, params, f"{mode} ({'below' if side == below else 'above'} the bracket)", same)
-    elif kind == "trend" and isinstance(varying, str):
-        _check_trend(check, claim, ok_runs, row, cache)
-    elif kind == "bound" and claim.get("metric"):
-        for run, params in ok_runs:
-            v = _statistic(run, claim, cache)
-            if v is None:
-                row(run, params, f"no {claim['metric']}")
-                continue
-            ok = True
-            if claim.get("lower") is not None:
-                ok = ok and (v > claim["lower"] if claim.get("strict") else v >= claim["lower"])
-            if claim.get("upper") is not None:
-                ok = ok and (v < claim["upper"] if claim.get("strict") else v <= claim["upper"])
-            row(run, params, f"{claim['metric']}{' ' + claim['statistic'] if claim.get('statistic') else ''} = {v:.4g}", ok)
-        if claim.get("quantifier") == "some" and any(r.ok for r in check.runs):
-            for r in check.runs:
-                r.ok = True if r.ok else None  # one run suffices; the others are shown
-    elif kind == "value" and claim.get("metric") and finite(claim.get("value")):
-        ref = float(claim["value"])
-        for run, params in ok_runs:
-            v = run.summary_value(claim["metric"])
-            row(run, params, f"{claim['metric']} = {v:.4g} ({100 * (v - ref) / ref:+.1f} % from {ref:.4g})"
-                if finite(v) else f"no {claim['metric']}")
-
-    judged = [r.ok for r in check.runs if r.ok is not None]
-    if kind == "value" or (kind in ("trend", "bound") and not claim.get("metric")):
-        check.verdict = "not checked"
-    elif problems or False in judged:
-        check.verdict = "inconsistent"
-    elif judged:
-        check.verdict = "consistent"
-    elif not ok_runs:
-        check.verdict = "no run"  # none, or none that finished
+def _value_text(claim: dict, row: dict) -> str:
+    """What a run shows for a claim, from a row of the ``caplab claims`` result."""
+    if row.get("status") != "ok":
+        return str(row.get("note") or f"run {row.get('status')}")
+    value, note = row.get("value"), str(row.get("note") or "")
+    if isinstance(value, str):
+        shown = value
+    elif finite(value):
+        statistic = f" {claim['statistic']}" if claim.get("statistic") else ""
+        shown = f"{claim.get('metric')}{statistic} = {value:.4g}"
     else:
-        check.verdict = "not enough runs" if kind == "trend" else "not checked"
-    check.note = "; ".join(problems)
-    return check
+        shown = ""
+    varying = claim.get("varying")
+    if isinstance(varying, str) and finite(row.get("parameter")):
+        shown += f" at {PARAMETER_SYMBOLS.get(varying) or varying} = {row['parameter']:g}"
+    if note:
+        shown = f"{shown} ({note})" if shown else note
+    return shown or "–"
 
 
-def _check_trend(check: ClaimCheck, claim: dict, ok_runs, row, cache) -> None:
-    """Runs that differ only in ``varying`` (same fidelity and grid) must move in the direction."""
-    varying, direction, metric = claim["varying"], claim.get("direction"), claim.get("metric")
-    groups: dict[tuple, list] = {}
-    for run, params in ok_runs:
-        key = tuple(params.get(k) for k in KEYS if k != varying) + (run.fidelity, run.fine_spacing)
-        if metric == "mode":
-            m = mode_of(run)
-            y = float(MODE_ORDER[m]) if m in MODE_ORDER else None
-        else:
-            y = _statistic(run, claim, cache)
-        if y is not None and finite(params.get(varying)):
-            groups.setdefault(key, []).append((params[varying], y, run, params))
-    symbol = PARAMETER_SYMBOLS.get(varying) or varying
-    for points in groups.values():
-        points.sort(key=lambda p: p[0])
-        for i, (x, y, run, params) in enumerate(points):
-            shown = mode_of(run) if metric == "mode" else f"{metric} = {y:.4g}"
-            if i == 0:
-                row(run, params, f"{shown} at {symbol} = {x:g}" + (" (first of its series)" if len(points) > 1 else " (alone)"))
-                continue
-            xp, yp = points[i - 1][0], points[i - 1][1]
-            if direction == "increasing":
-                ok = y > yp
-            elif direction == "decreasing" and metric != "mode":
-                ok = y < yp
-            elif direction == "approaches" and finite(claim.get("limit")):
-                ok = abs(y - claim["limit"]) < abs(yp - claim["limit"])
-            elif direction == "sequence":
-                ok = y >= yp  # along the stages as the parameter grows
-            elif direction == "decreasing":
-                ok = y <= yp  # the stages run the other way: as the parameter falls
-            else:
-                ok = None
-            row(run, params, f"{shown} at {symbol} = {x:g} (after {symbol} = {xp:g})", ok)
+def check_claims(claims: list[dict], runs: list[Run], claims_file: Path | None = None,
+                 only: str | None = None) -> list[ClaimCheck]:
+    """The verdict of each claim of ``claims`` on ``runs``, by ``caplab claims`` (solver/score/claims.hpp)
+    on ``claims_file`` (``--only``: ``only``), or on a document of ``claims`` when no file is given.
+    Runs without a directory (in the catalogue, never run) are not about any claim."""
+    checks = {c.get("id"): ClaimCheck(c, claim_summary(c), parameters_text(c.get("parameters"))) for c in claims}
+    by_dir = {str(r.directory.resolve()): r for r in runs if r.directory is not None}
+    if not by_dir:
+        return list(checks.values())
+    result = claims_tool.evaluate(claims_file or {"claims": claims}, [Path(d) for d in by_dir], only)
+    params = {str(Path(r["directory"]).resolve()): r.get("parameters") or {} for r in result.get("runs", [])}
+    for out in result.get("claims", []):
+        check = checks.get(out.get("id"))
+        if check is None:
+            continue
+        check.verdict = out.get("verdict") or "not checked"
+        if check.verdict in ("inconsistent", "not enough runs") or out.get("problems"):
+            check.note = str(out.get("message") or "")
+        for row in out.get("runs", []):
+            directory = str(Path(row["directory"]).resolve())
+            run = by_dir.get(directory)
+            ok = {"pass": True, "fail": False}.get(row.get("verdict"))
+            check.runs.append(ClaimRun(f"{row.get('run')} ({row.get('fidelity')})", run.anchor if run else "",
+                                       _value_text(check.claim, row), ok, str(row.get("scored") or ""),
+                                       _parameters_text(params.get(directory, {}))))
+    return list(checks.values())
+
+
+def check_claim(claim: dict, runs: list[Run]) -> ClaimCheck:
+    """``check_claims`` for one claim."""
+    return check_claims([claim], runs)[0]
 
 
 # ---- series and figures -----------------------------------------------------------------------
@@ -687,11 +598,17 @@ def build(runs: list[Run], refs: ReferenceLibrary, chapter: str) -> Capsules:
     except Exception as err:
         section.problems.append(f"convergence series failed: {err}")
 
-    used = {}
+    by_file: dict[str, tuple] = {}
     for ds, claim in refs.claims(chapter + "."):
-        section.claims.append(check_claim(claim, section.runs, cache))
-        used[ds.anchor] = ds
-    section.datasets = list(used.values())
+        by_file.setdefault(ds.anchor, (ds, []))[1].append(claim)
+    for ds, claims in by_file.values():
+        try:
+            section.claims += check_claims(claims, section.runs, ds.path, chapter + ".")
+        except claims_tool.ClaimsUnavailable as err:
+            section.problems.append(f"thesis statements of {ds.rel} not checked: {err}")
+            section.claims += [ClaimCheck(c, claim_summary(c), parameters_text(c.get("parameters")),
+                                          verdict="not checked", note=str(err)) for c in claims]
+    section.datasets = [ds for ds, _ in by_file.values()]
     if not section.claims:
         section.problems.append(f"no thesis statements for {chapter} in references/*/claims.json")
     for bench, entries in refs.provenance_entries("not_available"):

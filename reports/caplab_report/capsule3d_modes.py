@@ -28,7 +28,7 @@ said so):
    6.3), and the spheres' largest area change against G (the thesis's 0.4 % to 23.5 %, ≤ 1.8 %);
 4. one table per family (case, fidelity, mode, amplitudes, f/k, area and volume change, wall time),
    unfinished runs listed (never plotted), catalogue cases without a run named; and the verdicts of
-   the chapter's thesis statements, checked by capsule.py (capsule.check_claim) as for every
+   the chapter's thesis statements, checked by capsule.py (caplab claims) as for every
    chapter.
 """
 
@@ -809,7 +809,7 @@ class Modes3D:
 def build(runs: list[Run], refs: ReferenceLibrary, chapter: str,
           claims: list[capsule.ClaimCheck] | None = None) -> Modes3D:
     """The chapter 6 section; ``claims``: the chapter's checks already made by capsule.build (made
-    here with capsule.check_claim when not given)."""
+    here by capsule.build when not given)."""
     section = Modes3D()
     if chapter != CHAPTER:
         return section
@@ -861,7 +861,6 @@ def build(runs: list[Run], refs: ReferenceLibrary, chapter: str,
     section.tables = family_tables(mine, cache)
 
     if claims is None:
-        claims = [capsule.check_claim(c, [r for r in runs if capsule.is_capsule(r)], {})
-                  for _, c in refs.claims(CHAPTER + ".")]
+        claims = capsule.build(runs, refs, CHAPTER).claims
     section.claims = [ClaimVerdict(c) for c in claims]
     return section

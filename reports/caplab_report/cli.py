@@ -6,6 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from . import claims
 from .build import REPO, build_report
 
 
@@ -25,11 +26,15 @@ def parse_args(argv=None) -> argparse.Namespace:
                         "the overall index always covers every chapter")
     p.add_argument("--no-pdf", action="store_true", help="skip printing the PDFs")
     p.add_argument("--chromium", default="chromium", help="Chromium executable for the PDFs (default: chromium)")
+    p.add_argument("--caplab", type=Path, default=None,
+                   help="caplab executable that checks the thesis statements (`caplab claims`; default: $CAPLAB, "
+                        "else build/solver/app/caplab)")
     return p.parse_args(argv)
 
 
 def main(argv=None) -> int:
     args = parse_args(argv)
+    claims.set_executable(args.caplab)
     result = build_report(args.results, args.out, args.references, args.catalogue, args.fidelity or None,
                           args.chapter or None, pdf=not args.no_pdf, chromium=args.chromium)
     for problem in result.problems:

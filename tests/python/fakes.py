@@ -1,5 +1,7 @@
 """Hand-built run directories following the contract of DESIGN.md section 6, for the report tests
-and for the fake ``caplab`` of the reproduce tests (the solver is not needed to test either).
+and for the fake ``caplab`` of the reproduce tests. The solver is not needed to run either, but the
+report asks the built caplab (``caplab claims``, reports/caplab_report/claims.py) for the verdicts of
+the thesis statements, so the capsule report tests need `make build` first.
 
 ``make_run_dir(out, case, fidelity, outcome)`` writes what ``caplab run`` would write:
 case.json, manifest.json, series.h5, summary.json, score.json. Outcomes:
