@@ -65,7 +65,8 @@ int main(int argc, char** argv) {
   claims_cmd->add_option("claims", claims.claims_file, "Claims file, e.g. references/capsule2d/claims.json")
       ->required()
       ->check(CLI::ExistingFile);
-  claims_cmd->add_option("run_dirs", claims.run_dirs, "Run directories (non-capsule runs are ignored)")
+  claims_cmd->add_option("run_dirs", claims.run_dirs,
+                         "Run directories (capsule runs; other runs for the claims with a \"check\")")
       ->required()
       ->check(CLI::ExistingDirectory);
   claims_cmd->add_option("--json", claims.json_out, "Also write the verdicts as JSON to this file");

@@ -16,6 +16,7 @@
 #include "io/run_directory.hpp"
 #include "io/series_writer.hpp"
 #include "score/comparators.hpp"
+#include "score/motion_claims.hpp"
 #include "score/run_files.hpp"
 
 namespace caplab::score {
@@ -68,7 +69,7 @@ json read_object(const fs::path& file) { return read_json(file).doc.value_or(jso
 struct Run {
   fs::path dir;
   std::string case_id, fidelity, status;
-  json case_doc, summary, score, params;
+  json case_doc, summary, score, manifest, params;
   json fine_spacing;                                                 // numerics.grid.fine_spacing, or null
   std::optional<std::map<std::string, std::vector<double>>> series;  // capsule columns, read on use
 
@@ -129,7 +130,8 @@ Run load_run(const fs::path& dir) {
   run.case_doc = read_object(dir / "case.json");
   run.summary = read_object(dir / "summary.json");
   run.score = read_object(dir / "score.json");
-  const json manifest = read_object(dir / "manifest.json");
+  run.manifest = read_object(dir / "manifest.json");
+  const json& manifest = run.manifest;
   run.status = io::RunDirectory::run_status(dir);
   if (run.status == "missing") run.status = "incomplete";  // a directory without manifest: never finished
   for (const json* id : {&member(run.case_doc, "id"), &member(manifest, "case_id")})
@@ -574,6 +576,21 @@ json evaluate_claim(const json& claim, std::vector<Run>& runs) {
   return out;
 }
 
+/// A claim with a "check" object (motion_claims.hpp): runs chosen by case id, not by parameters.
+json evaluate_check_claim(const json& claim, std::vector<ClaimRun>& runs, const json& consistency) {
+  CheckOutcome outcome = check_motion_claim(claim, runs, consistency);
+  return {{"id", claim["id"]},
+          {"kind", member(claim, "kind")},
+          {"check", member(member(claim, "check"), "type")},
+          {"verdict", outcome.verdict},
+          {"message", outcome.message},
+          {"varying", member(claim, "varying")},
+          {"metric", member(claim, "metric")},
+          {"direction", member(claim, "direction")},
+          {"problems", json::array()},
+          {"runs", std::move(outcome.rows)}};
+}
+
 }  // namespace
 
 json evaluate_claims(const json& claims, const std::vector<fs::path>& run_dirs,
@@ -582,15 +599,35 @@ json evaluate_claims(const json& claims, const std::vector<fs::path>& run_dirs,
     throw core::InputError(
         "a claims file is {\"claims\": [...]} (references/capsule2d/claims.json); this one has no "
         "\"claims\" array");
-  json result = {{"claims_file", nullptr},    {"runs", json::array()},   {"ignored", json::array()},
-                 {"problems", json::array()}, {"claims", json::array()}, {"counts", json::object()}};
+  json result = {{"claims_file", nullptr},   {"runs", json::array()},     {"moving_runs", json::array()},
+                 {"ignored", json::array()}, {"problems", json::array()}, {"claims", json::array()},
+                 {"counts", json::object()}};
   std::vector<Run> runs;
+  std::vector<ClaimRun> check_runs;  // every run: the claims with a "check" choose by case id
   for (const auto& dir : run_dirs) {
     Run run = load_run(dir);
+    ClaimRun& check_run = check_runs.emplace_back();
+    check_run.dir = run.dir;
+    check_run.case_id = run.case_id;
+    check_run.fidelity = run.fidelity;
+    check_run.status = run.status;
+    check_run.case_doc = run.case_doc;
+    check_run.manifest = run.manifest;
+    check_run.score = run.score;
     if (!is_capsule(run)) {
-      result["ignored"].push_back(
-          {{"directory", dir.string()},
-           {"reason", "not a capsule run (no membrane body in case.json, no taylor_deformation_final)"}});
+      const bool moving = is_moving(run.case_doc);
+      if (moving)
+        result["moving_runs"].push_back({{"run", run.case_id},
+                                         {"fidelity", run.fidelity},
+                                         {"directory", dir.string()},
+                                         {"status", run.status}});
+      else
+        result["ignored"].push_back(
+            {{"directory", dir.string()},
+             {"reason",
+              "not a capsule run (no membrane body in case.json, no "
+              "taylor_deformation_final) nor a moving one: read only by claims with a "
+              "\"check\" that name its case"}});
       continue;
     }
     result["runs"].push_back({{"run", run.case_id},
@@ -614,7 +651,9 @@ json evaluate_claims(const json& claims, const std::vector<fs::path>& run_dirs,
       continue;
     }
     if (!id.get_ref<const std::string&>().starts_with(options.id_prefix)) continue;
-    json verdict = evaluate_claim(list[i], runs);
+    json verdict = member(list[i], "check").is_object()
+                       ? evaluate_check_claim(list[i], check_runs, options.consistency)
+                       : evaluate_claim(list[i], runs);
     auto& count = result["counts"][verdict["verdict"].get<std::string>()];
     count = count.is_null() ? 1 : count.get<int>() + 1;
     result["claims"].push_back(std::move(verdict));
@@ -629,7 +668,12 @@ json evaluate_claims(const fs::path& claims_file, const std::vector<fs::path>& r
   const json doc = json::parse(in, nullptr, /*allow_exceptions=*/false);
   if (doc.is_discarded())
     throw core::InputError("the claims file '" + claims_file.string() + "' is not valid JSON");
-  json result = evaluate_claims(doc, run_dirs, options);
+  ClaimsOptions with_consistency = options;
+  if (with_consistency.consistency.is_null()) {  // the start left out etc., beside the claims file
+    const json provenance = read_object(claims_file.parent_path() / "provenance.json");
+    with_consistency.consistency = member(provenance, "consistency");
+  }
+  json result = evaluate_claims(doc, run_dirs, with_consistency);
   result["claims_file"] = claims_file.string();
   return result;
 }
@@ -637,9 +681,9 @@ json evaluate_claims(const fs::path& claims_file, const std::vector<fs::path>& r
 std::string format_claims(const json& result) {
   const auto text = [](const json& v) { return v.is_string() ? v.get<std::string>() : std::string("-"); };
   const auto size = [](const json& v) { return v.is_array() ? v.size() : std::size_t{0}; };
-  std::string out = fmt::format("claims of {}: {} capsule run(s), {} other run(s) ignored\n",
+  std::string out = fmt::format("claims of {}: {} capsule run(s), {} moving-body run(s), {} other run(s)\n",
                                 text(member(result, "claims_file")), size(member(result, "runs")),
-                                size(member(result, "ignored")));
+                                size(member(result, "moving_runs")), size(member(result, "ignored")));
   out += fmt::format("{:<44} {:<8} {:<16} {}\n", "claim", "kind", "verdict", "runs judged/about");
   std::string notes;
   for (const auto& c : array_or_empty(member(result, "claims"))) {

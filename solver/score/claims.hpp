@@ -3,10 +3,17 @@
 // G", "tumbling above E_b = 0.06", ...? score.json stays the per-run verdict; this is the
 // verdict of a set of runs on one statement. Used by `caplab claims` and the reports.
 //
+// Two shapes of claim. A claim with a "check" object (references/moving/claims.json: moving
+// rigid bodies and the multi-block grid) names its runs by case id ("cases") and is judged by
+// that check: proximity_means, twin, refinement, fine_fraction, all of them in
+// motion_claims.hpp, which also gives the fields its run rows add ("details", "part",
+// "against"). Every other claim chooses capsule runs by parameters, as follows.
+//
 // Runs. A run directory is read for case.json, summary.json, manifest.json ("status",
-// "fidelity", "case_id") and, when a claim needs it, score.json and series.h5. Only capsule
-// runs are considered: a body with a "membrane" object, or a summary metric
-// taylor_deformation_final. Its fidelity is the manifest's (else case.json "fidelity_applied",
+// "fidelity", "case_id") and, when a claim needs it, score.json and series.h5. The claims with
+// a "check" see every run directory given (selection by case id; partners such as the uniform
+// twin by pairing). The others consider only capsule runs: a body with a "membrane" object, or
+// a summary metric taylor_deformation_final. Its fidelity is the manifest's (else case.json "fidelity_applied",
 // summary.json "fidelity", the name of the parent directory, results/<fidelity>/<case>); a
 // directory without manifest.json is "incomplete". A run's parameters in the keys of the claims are read from its
 // first membrane body, with the case-file defaults where a key is absent:
@@ -58,16 +65,22 @@
 // Layout of the result:
 //   {"claims_file": path | null,
 //    "runs": [{"run", "fidelity", "directory", "status", "parameters": {...}}],  // capsule runs
-//    "ignored": [{"directory", "reason"}], "problems": [...],   // claims without id, duplicates
-//    "claims": [{"id", "kind", "verdict", "message", "varying", "metric", "direction",
+//    "moving_runs": [{"run", "fidelity", "directory", "status"}],  // a prescribed-motion body
+//    "ignored": [{"directory", "reason"}],  // neither (still read by claims whose "cases" name them)
+//    "problems": [...],                     // claims without id, duplicates
+//    "claims": [{"id", "kind", "check"?, "verdict", "message", "varying", "metric", "direction",
 //                "problems": [...],
 //                "runs": [{"run", "fidelity", "directory", "status", "parameter", "value",
-//                          "verdict": pass | fail | null, "note"?, "series"?, "scored"?}],
+//                          "verdict": pass | fail | null, "note"?, "series"?, "scored"?,
+//                          "details"?, "part"?, "against"?}],
 //                "series"?: [{"fixed": {...}, "verdict", "error", "message"}]}],   // trends
 //    "counts": {verdict: number of claims}}
 // "parameter" is the run's value of "varying" (null when the claim varies none), "value" its
 // metric (a number, the mode string, or null), "series" the index of its trend series,
 // "scored" the score.json verdict of the acceptance entry naming the claim (when one does).
+// For a claim with a "check": "check" is its type, "value" and "note" of a row are texts and
+// "details" lists the lines behind them (motion_claims.hpp); a run may have several rows (one
+// per "part" of a fine_fraction check).
 #pragma once
 
 #include <filesystem>
@@ -80,6 +93,10 @@ namespace caplab::score {
 struct ClaimsOptions {
   /// Only the claims whose id starts with this (e.g. "ch3."); empty: every claim.
   std::string id_prefix;
+  /// The "consistency" object of references/moving/provenance.json (the start left out of
+  /// run-to-run differences) for the claims with a "check"; null: evaluate_claims on a file
+  /// reads it from the provenance.json beside that file, the document overload leaves out none.
+  nlohmann::json consistency = nullptr;
 };
 
 /// Evaluates every claim of `claims` (a document {"claims": [...]}) against the runs in

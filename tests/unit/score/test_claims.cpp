@@ -1,17 +1,23 @@
 // Unit tests of the cross-run check of thesis statements (score/claims.hpp) on hand-written run
 // directories (case.json, summary.json, manifest.json): which runs a claim is about, trend
 // series, brackets read as regimes, modes, bounds, what is "not checked" or undecided, and the
-// claims of references/capsule2d/claims.json that must be rejected.
+// claims of references/capsule2d/claims.json that must be rejected. The claims with a "check"
+// (score/motion_claims.hpp, references/moving/claims.json) on runs with made-up series.h5, each
+// check shown to fail where it must, and on the finished quick runs of tests/python/moving_runs.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "core/error.hpp"
+#include "io/series_writer.hpp"
 #include "score/claims.hpp"
 
 namespace caplab::score {
@@ -375,5 +381,311 @@ TEST_F(ScoreClaims, LawAspectRatioAndAreaDilationOf3DCapsules) {
   EXPECT_EQ(check(sk, runs)["runs"].size(), 1u);
 }
 
+
+// ---- claims with a "check": moving bodies and the multi-block grid (motion_claims.hpp) ----------
+
+const fs::path kMovingRuns = fs::path(CAPLAB_SOURCE_DIR) / "tests/python/moving_runs/quick";
+const fs::path kMovingClaims = fs::path(CAPLAB_SOURCE_DIR) / "references/moving/claims.json";
+
+/// A case.json of the fixture runs (the real case files as the solver copied them).
+json fixture_case(const std::string& dir_name) {
+  std::ifstream in(kMovingRuns / dir_name / "case.json");
+  return json::parse(in);
+}
+
+using Columns = std::vector<std::pair<std::string, std::vector<double>>>;
+
+/// t = 0.05, 0.10, ..., 32 as the two-cylinder runs (np.arange(0.05, 32 + 1e-9, 0.05)).
+std::vector<double> cylinder_times() {
+  std::vector<double> t;
+  for (int i = 0; i < 640; ++i) t.push_back(0.05 + i * 0.05);
+  return t;
+}
+
+/// C_d 1.8, `approach` over 0 < dx <= 3 (22.5 <= t < 24), `separation` over -3 <= dx < 0.
+std::vector<double> bump_drag(double approach, double separation) {
+  std::vector<double> drag;
+  for (double t : cylinder_times())
+    drag.push_back(t >= 22.5 && t < 24 ? approach : t > 24 && t <= 25.5 ? separation : 1.8);
+  return drag;
+}
+
+/// The columns of the two-cylinder case: the prescribed positions of the catalogue (x0 = 8,
+/// abreast at t = 24) and the given upper drag.
+Columns cylinders(const std::vector<double>& drag, double lift_offset = 0.0, double lower_shift = 0.0) {
+  const double pi = std::acos(-1.0);
+  Columns c{{"t", {}}, {"upper.x", {}}, {"lower.x", {}}, {"upper.drag_coefficient", drag},
+            {"upper.lift_coefficient", {}}, {"lower.drag_coefficient", {}}, {"lower.lift_coefficient", {}}};
+  const auto t = cylinder_times();
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const double s = 4 / pi * std::sin(pi * t[i] / 4), lift = 0.5 * std::sin(t[i]) + lift_offset;
+    c[0].second.push_back(t[i]);
+    c[1].second.push_back(t[i] < 16 ? 8 + 16 - s : 8 + 32 - t[i]);
+    c[2].second.push_back((t[i] < 16 ? 8 + s : 8 + t[i] - 16) + lower_shift);
+    c[4].second.push_back(lift);
+    c[5].second.push_back(-drag[i]);
+    c[6].second.push_back(-lift);
+  }
+  return c;
+}
+
+class MotionClaims : public ScoreClaims {
+ protected:
+  /// Writes a finished run of `case_doc` with `columns` in series.h5 and the cost in the manifest.
+  fs::path moving_run(const std::string& name, const json& case_doc, const Columns& columns,
+                      double node_updates = 1e9, const std::string& fidelity = "quick",
+                      const std::string& status = "ok") {
+    const fs::path d = dir_ / fidelity / name;
+    fs::create_directories(d);
+    std::ofstream(d / "case.json") << case_doc.dump();
+    std::ofstream(d / "manifest.json") << json{{"status", status},
+                                               {"case_id", case_doc["id"]},
+                                               {"fidelity", fidelity},
+                                               {"wall_time_s", 100.0},
+                                               {"threads", 2},
+                                               {"lattice", {{"node_updates", node_updates}}}}
+                                              .dump();
+    std::vector<io::SeriesColumn> names;
+    for (const auto& [n, v] : columns) names.push_back({n, "1", n});
+    io::SeriesWriter w(d / "series.h5", names);
+    for (std::size_t i = 0; i < columns[0].second.size(); ++i) {
+      std::vector<double> row;
+      for (const auto& [n, v] : columns) row.push_back(v[i]);
+      w.append(row);
+    }
+    w.close();
+    return d;
+  }
+
+  /// The result of the claim `id` of references/moving/claims.json (provenance.json beside it).
+  static json moving(const std::string& id, const std::vector<fs::path>& runs) {
+    const json result = evaluate_claims(kMovingClaims, runs, ClaimsOptions{id});
+    EXPECT_EQ(result["claims"].size(), 1u) << id;
+    return result["claims"][0];
+  }
+
+  /// The claim `id` of references/moving/claims.json, to be altered by a test.
+  static json moving_claim(const std::string& id) {
+    std::ifstream in(kMovingClaims);
+    const json doc = json::parse(in);
+    for (const auto& c : doc["claims"])
+      if (c["id"] == id) return c;
+    return nullptr;
+  }
+};
+
+bool contains(const json& text, const std::string& part) {
+  return text.is_string() && text.get<std::string>().find(part) != std::string::npos;
+}
+
+TEST_F(MotionClaims, ProximityMeansJudgeTheDragAroundTheEncounter) {
+  const std::string id = "ch2.two_cylinders.drag_trend";
+  const json two = fixture_case("ch2__two_cylinders_re40");
+  const json good = moving(id, {moving_run("good", two, cylinders(bump_drag(2.2, 1.2)))});
+  EXPECT_EQ(good["verdict"], "consistent") << good.dump(2);
+  EXPECT_EQ(good["check"], "proximity_means");
+  ASSERT_EQ(good["runs"].size(), 1u);
+  const json& row = good["runs"][0];
+  EXPECT_EQ(row["verdict"], "pass");
+  EXPECT_EQ(row["value"], "baseline: 1.8, approaching in close proximity: 2.2, moving away in close proximity: 1.2");
+  ASSERT_EQ(row["details"].size(), 4u);
+  EXPECT_TRUE(contains(row["details"][0], "baseline (6 ≤ dx ≤ 10, approaching): mean 1.8 over 41 samples"))
+      << row["details"][0];
+  EXPECT_TRUE(contains(row["details"][1], "(0 < dx ≤ 3, approaching): mean 2.2 over 30 samples, t = 22.5–23.95"))
+      << row["details"][1];
+  EXPECT_TRUE(contains(row["details"][3], "closest approach (dx = 0) at t = 24; the drag opposing the motion is C_d"));
+
+  // No rise, no fall, and a mean equal to the baseline is not above it.
+  for (const auto& [approach, separation] : {std::pair(1.5, 1.2), {2.2, 2.0}, {1.8, 1.2}}) {
+    const json bad = moving(id, {moving_run("bad", two, cylinders(bump_drag(approach, separation)))});
+    EXPECT_EQ(bad["verdict"], "inconsistent") << approach << " " << separation;
+    EXPECT_EQ(bad["runs"][0]["verdict"], "fail");
+    EXPECT_TRUE(contains(bad["message"], "is not")) << bad["message"];
+  }
+  // The bodies never pass each other: nothing to judge.
+  const json stuck = moving(id, {moving_run("stuck", two, cylinders(bump_drag(2.2, 1.2), 0.0, -40.0))});
+  EXPECT_EQ(stuck["verdict"], "not checked");
+  EXPECT_TRUE(contains(stuck["runs"][0]["note"], "never changes sign"));
+  // An unfinished run is listed, not judged.
+  const json diverged =
+      moving(id, {moving_run("diverged", two, cylinders(bump_drag(2.2, 1.2)), 1e9, "quick", "diverged")});
+  EXPECT_EQ(diverged["verdict"], "no run");
+  EXPECT_EQ(diverged["runs"][0]["note"], "run diverged");
+}
+
+TEST_F(MotionClaims, ProximityWindowOnTheWrongSideFailsAndTheLowerBodyOpposesWithMinusCd) {
+  const json two = fixture_case("ch2__two_cylinders_re40");
+  const fs::path run_dir = moving_run("run", two, cylinders(bump_drag(2.2, 1.2)));
+  // The drag does rise on the approach: a statement that it falls there must be rejected.
+  json wrong = moving_claim("ch2.two_cylinders.drag_trend");
+  wrong["check"]["windows"][0]["expect"] = "below";
+  const json w = check(wrong, {run_dir});
+  EXPECT_EQ(w["verdict"], "inconsistent") << w.dump(2);
+  EXPECT_TRUE(contains(w["message"], "approaching in close proximity: mean 2.2 is not below the baseline mean 1.8"))
+      << w["message"];
+
+  // The lower cylinder moves along +x: its C_d (−1.8 at rest, the made-up series) opposes the
+  // motion with the sign flipped, and dx = x_lower − x_upper runs from −16 to 16.
+  json lower = moving_claim("ch2.two_cylinders.drag_trend");
+  lower["check"]["body"] = "lower";
+  lower["check"]["other"] = "upper";
+  lower["check"]["baseline"] = {{"dx", "[-10, -6]"}, {"phase", "approaching"}};
+  lower["check"]["windows"] = {{{"name", "a"}, {"dx", "[-3, 0)"}, {"phase", "approaching"}, {"expect", "above"}},
+                               {{"name", "s"}, {"dx", "(0, 3]"}, {"phase", "separating"}, {"expect", "below"}}};
+  const json l = check(lower, {run_dir});
+  EXPECT_EQ(l["verdict"], "consistent") << l.dump(2);
+  EXPECT_EQ(l["runs"][0]["value"], "baseline: 1.8, a: 2.2, s: 1.2");
+  EXPECT_TRUE(contains(l["runs"][0]["details"][3], "is −C_d (the lower body moves along +x)"));
+
+  // A window that is no interval, a phase that is no phase: the claim is wrong, not the run.
+  json malformed = moving_claim("ch2.two_cylinders.drag_trend");
+  malformed["check"]["windows"][0]["dx"] = "(3, 0]";
+  EXPECT_EQ(check(malformed, {run_dir})["verdict"], "not checked");
+  EXPECT_TRUE(contains(check(malformed, {run_dir})["message"], "empty interval"));
+  malformed["check"]["windows"][0]["dx"] = "(0, 3]";
+  malformed["check"]["baseline"]["phase"] = "before";
+  EXPECT_TRUE(contains(check(malformed, {run_dir})["message"], "phase must be approaching or separating"));
+  json unknown = moving_claim("ch2.two_cylinders.drag_trend");
+  unknown["check"]["type"] = "closeness";
+  EXPECT_EQ(check(unknown, {run_dir})["verdict"], "not checked");
+}
+
+TEST_F(MotionClaims, TwinDifferenceAgainstTheUniformGrid) {
+  const std::string id = "ch2.two_cylinders.uniform_twin";
+  const json two = fixture_case("ch2__two_cylinders_re40"), uni = fixture_case("ch2__two_cylinders_re40_uniform");
+  const Columns cols = cylinders(bump_drag(2.2, 1.2));
+  const fs::path a = moving_run("a", two, cols);
+  const json same = moving(id, {a, moving_run("b", uni, cols)});
+  EXPECT_EQ(same["verdict"], "consistent") << same.dump(2);
+  ASSERT_EQ(same["runs"].size(), 1u);  // the claim is about the two-block run; the twin is its partner
+  EXPECT_EQ(same["runs"][0]["value"], "upper C_d 0.00 %; upper C_l 0.00 % (at most 2.00 %)");
+  EXPECT_EQ(same["runs"][0]["against"], "ch2/two_cylinders_re40_uniform (quick)");
+  EXPECT_TRUE(contains(same["runs"][0]["details"][0], "against ch2/two_cylinders_re40_uniform (quick), t ≥ 0.5: "))
+      << same["runs"][0]["details"];
+
+  // A lift 0.05 off over the twin's peak 0.55 is 9.09 %: above the 2 %.
+  const json off = moving(id, {a, moving_run("c", uni, cylinders(bump_drag(2.2, 1.2), 0.05))});
+  EXPECT_EQ(off["verdict"], "inconsistent");
+  EXPECT_EQ(off["runs"][0]["value"], "upper C_d 0.00 %; upper C_l 9.09 % (at most 2.00 %)");
+  EXPECT_TRUE(contains(off["message"], "upper C_l 9.09 % is above 2.00 %"));
+
+  // Not a twin: other physics, another fine spacing, another fidelity. Without one: not enough runs.
+  json other = uni, coarser = uni;
+  other["physics"]["reynolds"] = 41;
+  coarser["numerics"]["grid"]["fine_spacing"] = 0.05;
+  const json none = moving(id, {a, moving_run("d", other, cols), moving_run("e", coarser, cols),
+                                moving_run("f", uni, cols, 3e9, "standard")});
+  EXPECT_EQ(none["verdict"], "not enough runs") << none.dump(2);
+  EXPECT_EQ(none["runs"][0]["note"], "no uniform-grid twin run at fidelity quick");
+  EXPECT_EQ(moving(id, {})["verdict"], "no run");
+
+  // A twin that differs in other numerics too: named in the details.
+  json faster = uni;
+  faster["numerics"]["lattice_velocity"] = 0.1;
+  const json differs = moving(id, {a, moving_run("g", faster, cols)});
+  EXPECT_EQ(differs["runs"][0]["details"][1], "the runs also differ in numerics.lattice_velocity");
+}
+
+TEST_F(MotionClaims, RefinementAgainstTheFinestGridOfTheCase) {
+  const std::string id = "ch2.hovering_wing.refinement";
+  const json wing = fixture_case("ch2__hovering_wing_re157");
+  json finer = wing;
+  finer["numerics"]["grid"]["fine_spacing"] = wing["numerics"]["grid"]["fine_spacing"].get<double>() / 2;
+  auto series = [](double drag_scale) {
+    Columns c{{"t", {}}, {"drag_coefficient", {}}, {"lift_coefficient", {}}};
+    for (double t = 0.02; t < 31.42; t += 0.02) {
+      c[0].second.push_back(t);
+      c[1].second.push_back(drag_scale * std::cos(0.8 * t));
+      c[2].second.push_back(1 + std::sin(0.8 * t));
+    }
+    return c;
+  };
+  const fs::path a = moving_run("a", wing, series(1.0));
+  const json one = moving(id, {a});
+  EXPECT_EQ(one["verdict"], "not enough runs");
+  EXPECT_TRUE(contains(one["runs"][0]["note"], "one grid only (Δx_f = 0.03125 (quick))")) << one["runs"][0];
+  const json same = moving(id, {a, moving_run("b", finer, series(1.0), 1e9, "standard")});
+  EXPECT_EQ(same["verdict"], "consistent") << same.dump(2);
+  EXPECT_EQ(same["runs"][0]["details"][0], "Δx_f = 0.03125 against the finer Δx_f = 0.015625 (self-reference)");
+  EXPECT_EQ(same["runs"][0]["against"], "ch2/hovering_wing_re157 (standard)");
+  const json off = moving(id, {a, moving_run("c", finer, series(1.2), 1e9, "standard")});
+  EXPECT_EQ(off["verdict"], "inconsistent");
+  EXPECT_TRUE(contains(off["runs"][0]["value"], "; C_l 0.00 % (at most 2.00 %)")) << off["runs"][0]["value"];
+}
+
+TEST_F(MotionClaims, FineFractionAndTheSavingOfTheTwoBlockGrid) {
+  const std::string id = "ch2.two_cylinders.fine_fraction";
+  const json two = fixture_case("ch2__two_cylinders_re40"), uni = fixture_case("ch2__two_cylinders_re40_uniform");
+  const Columns cols = cylinders(bump_drag(2.2, 1.2));
+  const fs::path a = moving_run("a", two, cols, 1e9), b = moving_run("b", uni, cols, 3e9);
+  const json ok = moving(id, {a, b});
+  EXPECT_EQ(ok["verdict"], "consistent") << ok.dump(2);
+  ASSERT_EQ(ok["runs"].size(), 3u);
+  EXPECT_EQ(ok["runs"][0]["part"], "fine fraction");
+  EXPECT_EQ(ok["runs"][0]["value"], "24.06 % as set, – as built (thesis 24.1 %, within 0.05 %)");
+  EXPECT_EQ(ok["runs"][1]["value"],
+            "node updates twin/two-block 3 (saving 66.67 %); wall time 1 (saving 0.00 %, not judged: noisy)");
+  EXPECT_EQ(ok["runs"][2]["part"], "saving less than ch2/cylinder_re100");
+  EXPECT_TRUE(ok["runs"][2]["verdict"].is_null());
+  EXPECT_TRUE(contains(ok["message"], "not judged: ch2/two_cylinders_re40 (quick): saving less than"));
+
+  // The uniform grid cheaper than the two-block one: no saving.
+  EXPECT_EQ(moving(id, {a, moving_run("c", uni, cols, 0.5e9)})["verdict"], "inconsistent");
+  // A fine block of another size than the thesis's 24.1 %.
+  json bigger = two;
+  bigger["numerics"]["grid"]["fine_region"]["max"] = {28, 11.6};
+  const json big = moving(id, {moving_run("d", bigger, cols), b});
+  EXPECT_EQ(big["verdict"], "inconsistent");
+  EXPECT_EQ(big["runs"][0]["note"], "25.16 % is not within 0.05 % of 24.1 %");
+  // No twin: the fraction alone decides, the saving waits for runs.
+  EXPECT_EQ(moving(id, {a})["verdict"], "consistent");
+
+  // The saving must be smaller than that of the fixed cylinder of section 2.2.1 (a fixed body:
+  // not a moving run, read all the same because the check names its case).
+  std::ifstream c1(fs::path(CAPLAB_SOURCE_DIR) / "catalogue/ch2/cylinder_re100.json");
+  std::ifstream c2(fs::path(CAPLAB_SOURCE_DIR) / "catalogue/ch2/cylinder_re100_uniform.json");
+  const json cyl = json::parse(c1);
+  json cyl_uni = json::parse(c2);
+  cyl_uni["numerics"]["grid"]["fine_spacing"] = cyl["numerics"]["grid"]["fine_spacing"];
+  const Columns cyl_cols{{"t", {0, 1, 2}}, {"drag_coefficient", {1, 1, 1}}};
+  for (const auto& [ratio, verdict] : {std::pair(10.0, "consistent"), {2.0, "inconsistent"}}) {
+    const fs::path p = moving_run("cyl" + std::to_string(int(ratio)), cyl, cyl_cols, 1e9);
+    const fs::path q = moving_run("cyl_uniform" + std::to_string(int(ratio)), cyl_uni, cyl_cols, ratio * 1e9);
+    const json result = evaluate_claims(kMovingClaims, {a, b, p, q}, ClaimsOptions{id});
+    EXPECT_EQ(result["claims"][0]["verdict"], verdict) << ratio;
+    EXPECT_EQ(result["claims"][0]["runs"][2]["verdict"], ratio > 3 ? "pass" : "fail");
+    EXPECT_EQ(result["moving_runs"].size(), 2u);  // the fixed cylinders are not moving runs
+    EXPECT_EQ(result["ignored"].size(), 2u);
+  }
+}
+
+// The finished quick runs of the moving-body cases: the verdicts and numbers that the report
+// showed when it checked these statements itself (tests/python/test_moving_report.py).
+TEST_F(MotionClaims, QuickRunsOfTheCatalogue) {
+  std::vector<fs::path> runs;
+  for (const auto& e : fs::directory_iterator(kMovingRuns)) runs.push_back(e.path());
+  std::sort(runs.begin(), runs.end());
+  const json result = evaluate_claims(kMovingClaims, runs);
+  EXPECT_EQ(result["moving_runs"].size(), 5u);
+  std::map<std::string, json> by_id;
+  for (const auto& c : result["claims"]) by_id[c["id"]] = c;
+  const json& trend = by_id["ch2.two_cylinders.drag_trend"];
+  EXPECT_EQ(trend["verdict"], "inconsistent");
+  ASSERT_EQ(trend["runs"].size(), 2u);
+  EXPECT_EQ(trend["runs"][0]["value"],
+            "baseline: 1.86, approaching in close proximity: 1.585, moving away in close proximity: 1.558");
+  EXPECT_TRUE(contains(trend["runs"][0]["details"][1], "max 2.287 at dx = 1.8, min 0.8544 at dx = 0.202"));
+  EXPECT_EQ(by_id["ch2.two_cylinders.uniform_twin"]["verdict"], "inconsistent");
+  EXPECT_EQ(by_id["ch2.two_cylinders.uniform_twin"]["runs"][0]["value"],
+            "upper C_d 1.78 %; upper C_l 3.50 % (at most 2.00 %)");
+  EXPECT_EQ(by_id["ch2.two_cylinders.fine_fraction"]["verdict"], "consistent");
+  EXPECT_EQ(by_id["ch2.two_cylinders.fine_fraction"]["runs"][0]["value"],
+            "24.06 % as set, 23.79 % as built (thesis 24.1 %, within 0.05 %)");
+  EXPECT_TRUE(contains(by_id["ch2.two_cylinders.fine_fraction"]["runs"][1]["value"],
+                       "node updates twin/two-block 2.75 (saving 63.60 %)"));
+  EXPECT_EQ(by_id["ch2.hovering_wing.twin"]["verdict"], "consistent");
+  EXPECT_EQ(by_id["ch2.hovering_wing.twin"]["runs"][0]["value"], "C_d 0.44 %; C_l 0.36 % (at most 2.00 %)");
+  EXPECT_EQ(by_id["ch2.hovering_wing.refinement"]["verdict"], "not enough runs");
+}
 }  // namespace
 }  // namespace caplab::score
