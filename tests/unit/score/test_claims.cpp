@@ -381,7 +381,6 @@ TEST_F(ScoreClaims, LawAspectRatioAndAreaDilationOf3DCapsules) {
   EXPECT_EQ(check(sk, runs)["runs"].size(), 1u);
 }
 
-
 // ---- claims with a "check": moving bodies and the multi-block grid (motion_claims.hpp) ----------
 
 const fs::path kMovingRuns = fs::path(CAPLAB_SOURCE_DIR) / "tests/python/moving_runs/quick";
@@ -414,8 +413,13 @@ std::vector<double> bump_drag(double approach, double separation) {
 /// abreast at t = 24) and the given upper drag.
 Columns cylinders(const std::vector<double>& drag, double lift_offset = 0.0, double lower_shift = 0.0) {
   const double pi = std::acos(-1.0);
-  Columns c{{"t", {}}, {"upper.x", {}}, {"lower.x", {}}, {"upper.drag_coefficient", drag},
-            {"upper.lift_coefficient", {}}, {"lower.drag_coefficient", {}}, {"lower.lift_coefficient", {}}};
+  Columns c{{"t", {}},
+            {"upper.x", {}},
+            {"lower.x", {}},
+            {"upper.drag_coefficient", drag},
+            {"upper.lift_coefficient", {}},
+            {"lower.drag_coefficient", {}},
+            {"lower.lift_coefficient", {}}};
   const auto t = cylinder_times();
   for (std::size_t i = 0; i < t.size(); ++i) {
     const double s = 4 / pi * std::sin(pi * t[i] / 4), lift = 0.5 * std::sin(t[i]) + lift_offset;
@@ -438,13 +442,11 @@ class MotionClaims : public ScoreClaims {
     const fs::path d = dir_ / fidelity / name;
     fs::create_directories(d);
     std::ofstream(d / "case.json") << case_doc.dump();
-    std::ofstream(d / "manifest.json") << json{{"status", status},
-                                               {"case_id", case_doc["id"]},
-                                               {"fidelity", fidelity},
-                                               {"wall_time_s", 100.0},
-                                               {"threads", 2},
-                                               {"lattice", {{"node_updates", node_updates}}}}
-                                              .dump();
+    std::ofstream(d / "manifest.json")
+        << json{{"status", status},     {"case_id", case_doc["id"]},
+                {"fidelity", fidelity}, {"wall_time_s", 100.0},
+                {"threads", 2},         {"lattice", {{"node_updates", node_updates}}}}
+               .dump();
     std::vector<io::SeriesColumn> names;
     for (const auto& [n, v] : columns) names.push_back({n, "1", n});
     io::SeriesWriter w(d / "series.h5", names);
@@ -487,13 +489,16 @@ TEST_F(MotionClaims, ProximityMeansJudgeTheDragAroundTheEncounter) {
   ASSERT_EQ(good["runs"].size(), 1u);
   const json& row = good["runs"][0];
   EXPECT_EQ(row["verdict"], "pass");
-  EXPECT_EQ(row["value"], "baseline: 1.8, approaching in close proximity: 2.2, moving away in close proximity: 1.2");
+  EXPECT_EQ(row["value"],
+            "baseline: 1.8, approaching in close proximity: 2.2, moving away in close proximity: 1.2");
   ASSERT_EQ(row["details"].size(), 4u);
   EXPECT_TRUE(contains(row["details"][0], "baseline (6 ≤ dx ≤ 10, approaching): mean 1.8 over 41 samples"))
       << row["details"][0];
-  EXPECT_TRUE(contains(row["details"][1], "(0 < dx ≤ 3, approaching): mean 2.2 over 30 samples, t = 22.5–23.95"))
+  EXPECT_TRUE(
+      contains(row["details"][1], "(0 < dx ≤ 3, approaching): mean 2.2 over 30 samples, t = 22.5–23.95"))
       << row["details"][1];
-  EXPECT_TRUE(contains(row["details"][3], "closest approach (dx = 0) at t = 24; the drag opposing the motion is C_d"));
+  EXPECT_TRUE(contains(row["details"][3],
+                       "closest approach (dx = 0) at t = 24; the drag opposing the motion is C_d"));
 
   // No rise, no fall, and a mean equal to the baseline is not above it.
   for (const auto& [approach, separation] : {std::pair(1.5, 1.2), {2.2, 2.0}, {1.8, 1.2}}) {
@@ -521,7 +526,8 @@ TEST_F(MotionClaims, ProximityWindowOnTheWrongSideFailsAndTheLowerBodyOpposesWit
   wrong["check"]["windows"][0]["expect"] = "below";
   const json w = check(wrong, {run_dir});
   EXPECT_EQ(w["verdict"], "inconsistent") << w.dump(2);
-  EXPECT_TRUE(contains(w["message"], "approaching in close proximity: mean 2.2 is not below the baseline mean 1.8"))
+  EXPECT_TRUE(
+      contains(w["message"], "approaching in close proximity: mean 2.2 is not below the baseline mean 1.8"))
       << w["message"];
 
   // The lower cylinder moves along +x: its C_d (−1.8 at rest, the made-up series) opposes the
@@ -530,8 +536,9 @@ TEST_F(MotionClaims, ProximityWindowOnTheWrongSideFailsAndTheLowerBodyOpposesWit
   lower["check"]["body"] = "lower";
   lower["check"]["other"] = "upper";
   lower["check"]["baseline"] = {{"dx", "[-10, -6]"}, {"phase", "approaching"}};
-  lower["check"]["windows"] = {{{"name", "a"}, {"dx", "[-3, 0)"}, {"phase", "approaching"}, {"expect", "above"}},
-                               {{"name", "s"}, {"dx", "(0, 3]"}, {"phase", "separating"}, {"expect", "below"}}};
+  lower["check"]["windows"] = {
+      {{"name", "a"}, {"dx", "[-3, 0)"}, {"phase", "approaching"}, {"expect", "above"}},
+      {{"name", "s"}, {"dx", "(0, 3]"}, {"phase", "separating"}, {"expect", "below"}}};
   const json l = check(lower, {run_dir});
   EXPECT_EQ(l["verdict"], "consistent") << l.dump(2);
   EXPECT_EQ(l["runs"][0]["value"], "baseline: 1.8, a: 2.2, s: 1.2");
@@ -552,7 +559,8 @@ TEST_F(MotionClaims, ProximityWindowOnTheWrongSideFailsAndTheLowerBodyOpposesWit
 
 TEST_F(MotionClaims, TwinDifferenceAgainstTheUniformGrid) {
   const std::string id = "ch2.two_cylinders.uniform_twin";
-  const json two = fixture_case("ch2__two_cylinders_re40"), uni = fixture_case("ch2__two_cylinders_re40_uniform");
+  const json two = fixture_case("ch2__two_cylinders_re40"),
+             uni = fixture_case("ch2__two_cylinders_re40_uniform");
   const Columns cols = cylinders(bump_drag(2.2, 1.2));
   const fs::path a = moving_run("a", two, cols);
   const json same = moving(id, {a, moving_run("b", uni, cols)});
@@ -560,7 +568,8 @@ TEST_F(MotionClaims, TwinDifferenceAgainstTheUniformGrid) {
   ASSERT_EQ(same["runs"].size(), 1u);  // the claim is about the two-block run; the twin is its partner
   EXPECT_EQ(same["runs"][0]["value"], "upper C_d 0.00 %; upper C_l 0.00 % (at most 2.00 %)");
   EXPECT_EQ(same["runs"][0]["against"], "ch2/two_cylinders_re40_uniform (quick)");
-  EXPECT_TRUE(contains(same["runs"][0]["details"][0], "against ch2/two_cylinders_re40_uniform (quick), t ≥ 0.5: "))
+  EXPECT_TRUE(
+      contains(same["runs"][0]["details"][0], "against ch2/two_cylinders_re40_uniform (quick), t ≥ 0.5: "))
       << same["runs"][0]["details"];
 
   // A lift 0.05 off over the twin's peak 0.55 is 9.09 %: above the 2 %.
@@ -606,7 +615,8 @@ TEST_F(MotionClaims, RefinementAgainstTheFinestGridOfTheCase) {
   EXPECT_TRUE(contains(one["runs"][0]["note"], "one grid only (Δx_f = 0.03125 (quick))")) << one["runs"][0];
   const json same = moving(id, {a, moving_run("b", finer, series(1.0), 1e9, "standard")});
   EXPECT_EQ(same["verdict"], "consistent") << same.dump(2);
-  EXPECT_EQ(same["runs"][0]["details"][0], "Δx_f = 0.03125 against the finer Δx_f = 0.015625 (self-reference)");
+  EXPECT_EQ(same["runs"][0]["details"][0],
+            "Δx_f = 0.03125 against the finer Δx_f = 0.015625 (self-reference)");
   EXPECT_EQ(same["runs"][0]["against"], "ch2/hovering_wing_re157 (standard)");
   const json off = moving(id, {a, moving_run("c", finer, series(1.2), 1e9, "standard")});
   EXPECT_EQ(off["verdict"], "inconsistent");
@@ -615,7 +625,8 @@ TEST_F(MotionClaims, RefinementAgainstTheFinestGridOfTheCase) {
 
 TEST_F(MotionClaims, FineFractionAndTheSavingOfTheTwoBlockGrid) {
   const std::string id = "ch2.two_cylinders.fine_fraction";
-  const json two = fixture_case("ch2__two_cylinders_re40"), uni = fixture_case("ch2__two_cylinders_re40_uniform");
+  const json two = fixture_case("ch2__two_cylinders_re40"),
+             uni = fixture_case("ch2__two_cylinders_re40_uniform");
   const Columns cols = cylinders(bump_drag(2.2, 1.2));
   const fs::path a = moving_run("a", two, cols, 1e9), b = moving_run("b", uni, cols, 3e9);
   const json ok = moving(id, {a, b});
