@@ -23,7 +23,8 @@
 //                    the samples of all windows; |ū| ≤ 1e-9: not judged. A window's mean needs
 //                    kMinSamples finite samples; without the baseline's the run is not judged.
 //                    Each window passes when its mean is "expect": above (>) or below (<) the
-//                    baseline mean; the run passes when every window passes.
+//                    baseline mean; the run passes when every window passes, and fails when
+//                    one fails (even if another window has too few samples to be judged).
 //   twin             per run: the relative RMS (below) of each of "columns" against the uniform
 //                    twin, at most the claim's "upper". The twin of a run with
 //                    numerics.grid.refinement "two_level": another run with refinement "uniform",

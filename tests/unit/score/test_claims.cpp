@@ -578,6 +578,17 @@ TEST_F(MotionClaims, TwinDifferenceAgainstTheUniformGrid) {
   EXPECT_EQ(off["runs"][0]["value"], "upper C_d 0.00 %; upper C_l 9.09 % (at most 2.00 %)");
   EXPECT_TRUE(contains(off["message"], "upper C_l 9.09 % is above 2.00 %"));
 
+  // The impulsive start before t = 0.5 (provenance.json consistency.twin_difference.from) is
+  // left out of the difference and of the peak; a non-finite sample after it is never a pass.
+  Columns spiky = cols, nan = cols;
+  for (std::size_t i = 0; i < spiky[0].second.size(); ++i)
+    if (spiky[0].second[i] < 0.5) spiky[3].second[i] = 50.0;
+  nan[4].second[300] = std::nan("");
+  EXPECT_EQ(moving(id, {a, moving_run("spiky", uni, spiky)})["verdict"], "consistent");
+  const json not_a_number = moving(id, {a, moving_run("nan", uni, nan)});
+  EXPECT_EQ(not_a_number["verdict"], "inconsistent");
+  EXPECT_EQ(not_a_number["runs"][0]["note"], "upper C_l is not a number");
+
   // Not a twin: other physics, another fine spacing, another fidelity. Without one: not enough runs.
   json other = uni, coarser = uni;
   other["physics"]["reynolds"] = 41;
