@@ -14,7 +14,9 @@ What a chapter page gets, kept apart as in capsule.py (conventions in references
 - thesis statements (references/moving/claims.json, ids "<chapter>.*"): the drag trend is checked
   on the flow of each run; the statements about the multi-block method (uniform twin, refinement,
   fine fraction and cost) by comparing caplab runs with each other, which is consistency, caplab
-  against caplab, not validation. Verdicts: pass, fail, not run;
+  against caplab, not validation. The checks are the C++ scorer's (``caplab claims``,
+  solver/score/motion_claims.hpp, through claims.py); this module shows its verdicts (consistent,
+  inconsistent, no run, not enough runs, not checked), rows and detail lines;
 - verification and consistency: every two-block/twin pair (relative RMS difference of every force
   column, node updates, wall time), and periodicity and period means of periodic motions
   (provenance.json "consistency");
@@ -24,7 +26,9 @@ What a chapter page gets, kept apart as in capsule.py (conventions in references
   between the reference series themselves, the yardstick of the tolerance.
 
 Every number shown is computed from the runs and the reference files; the numbers of each check
-(windows, tolerances) are read from claims.json and provenance.json, never written here.
+(windows, tolerances) are read from claims.json and provenance.json, never written here. The
+window means drawn in the C_d-against-dx panel (proximity_means) are recomputed here for the
+figure only; the verdict on them is caplab's.
 """
 
 from __future__ import annotations
@@ -33,7 +37,9 @@ import copy
 import json
 import math
 import re
+import tempfile
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import matplotlib
 
@@ -41,6 +47,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from . import claims as claims_tool  # noqa: E402
 from . import figures  # noqa: E402
 from .references import Dataset, ReferenceLibrary  # noqa: E402
 from .runs import Run, finite  # noqa: E402
@@ -50,7 +57,6 @@ CLAIMS_FILE = "claims.json"
 FORCES = ("drag_coefficient", "lift_coefficient")
 SYMBOLS = {"drag_coefficient": "C_d", "lift_coefficient": "C_l"}
 MIN_SAMPLES = 3  #: fewer samples in a window than this and its mean is not taken
-VERDICTS = ("pass", "fail", "not run")
 
 
 # ---- what a moving run is -------------------------------------------------------------------------
@@ -164,13 +170,11 @@ class WindowMean:
     name: str
     interval: Interval
     phase: str
-    expect: str | None = None  #: "above" | "below" the baseline; None for the baseline itself
     mean: float | None = None
     samples: int = 0
     t_span: tuple[float, float] | None = None
     peak: tuple[float, float] | None = None     #: (largest value, its dx)
     trough: tuple[float, float] | None = None   #: (smallest value, its dx)
-    ok: bool | None = None
 
     @property
     def text(self) -> str:
@@ -179,7 +183,8 @@ class WindowMean:
 
 @dataclass
 class Proximity:
-    """The drag-trend check on one run: the baseline, the windows, the sign of 'opposing'."""
+    """The windows of the drag-trend statement on one run, for the figure: the baseline, the
+    windows, the sign of 'opposing' (the verdict is caplab's, motion_claims.hpp)."""
 
     baseline: WindowMean
     windows: list[WindowMean]
@@ -187,27 +192,17 @@ class Proximity:
     encounter: float | None = None
     problem: str = ""
 
-    @property
-    def ok(self) -> bool | None:
-        judged = [w.ok for w in self.windows if w.ok is not None]
-        if self.problem or len(judged) < len(self.windows):
-            return None
-        return all(judged)
-
 
 def _window(spec: dict, name: str) -> WindowMean:
     phase = spec.get("phase")
     if phase not in ("approaching", "separating"):
         raise ValueError(f"window {name}: phase must be approaching or separating (got {phase!r})")
-    expect = spec.get("expect")
-    if expect not in (None, "above", "below"):
-        raise ValueError(f"window {name}: expect must be above or below (got {expect!r})")
-    return WindowMean(name, parse_interval(spec.get("dx", "")), phase, expect)
+    return WindowMean(name, parse_interval(spec.get("dx", "")), phase)
 
 
 def proximity_means(t, x_body, x_other, values, check: dict) -> Proximity:
     """Means of ``values`` (the body's C_d) over the windows of dx = x_body - x_other of ``check``
-    (claims.json ``proximity_means``), each compared with the baseline window."""
+    (claims.json ``proximity_means``), as motion_claims.hpp takes them, for the figure."""
     t, x_body, x_other, values = (np.asarray(a, dtype=float) for a in (t, x_body, x_other, values))
     base = _window(check.get("baseline") or {}, "baseline")
     base.name = "baseline"
@@ -244,10 +239,6 @@ def proximity_means(t, x_body, x_other, values, check: dict) -> Proximity:
         w.peak, w.trough = (float(v[i]), float(dx[sel][i])), (float(v[j]), float(dx[sel][j]))
     if base.mean is None:
         result.problem = f"fewer than {MIN_SAMPLES} samples in the baseline window ({base.text})"
-        return result
-    for w in result.windows:
-        if w.mean is not None:
-            w.ok = w.mean > base.mean if w.expect == "above" else w.mean < base.mean if w.expect == "below" else None
     return result
 
 
@@ -431,10 +422,12 @@ def period_mean(t, y, period: float, first: int) -> tuple[float, int] | None:
     return float(np.sum(0.5 * (ys[1:] + ys[:-1]) * np.diff(ts)) / (ts[-1] - ts[0])), n
 
 
-# ---- thesis statements ------------------------------------------------------------------------------
+# ---- thesis statements: the verdicts of `caplab claims` ----------------------------------------------
 
 @dataclass
 class Part:
+    """One row of the result of ``caplab claims`` for a statement (solver/score/motion_claims.hpp)."""
+
     label: str
     anchor: str
     text: str
@@ -448,7 +441,7 @@ class StatementCheck:
     what: str
     group: str                 #: "flow" (checked on each run) | "method" (caplab against caplab)
     parts: list[Part] = field(default_factory=list)
-    verdict: str = "not run"
+    verdict: str = "no run"    #: caplab's: consistent | inconsistent | no run | not enough runs | not checked
     note: str = ""
 
     @property
@@ -457,178 +450,52 @@ class StatementCheck:
         return str(check.get("basis", "")) if isinstance(check, dict) else ""
 
 
-def _verdict(parts: list[Part]) -> tuple[str, str]:
-    judged = [p.ok for p in parts if p.ok is not None]
-    if False in judged:
-        return "fail", ""
-    if judged:
-        unjudged = [p.label for p in parts if p.ok is None]
-        return "pass", ("not judged: " + "; ".join(unjudged)) if unjudged else ""
-    return "not run", ""
+def _part(row: dict, by_dir: dict[str, Run]) -> Part:
+    run = by_dir.get(str(Path(row.get("directory", "")).resolve()))
+    label_ = f"{row.get('run')} ({row.get('fidelity')})" + (f": {row['part']}" if row.get("part") else "")
+    value, note = row.get("value"), str(row.get("note") or "")
+    text = f"{value} ({note})" if value and note else (value or note or "–")
+    ok = {"pass": True, "fail": False}.get(row.get("verdict"))
+    return Part(label_, run.anchor if run is not None else "", text, ok, [str(d) for d in row.get("details") or []])
 
 
-def _not_ok(run: Run) -> Part:
-    what = "no run" if run.status == "missing" else f"run {run.status_label.lower()}"
-    return Part(label(run), run.anchor, what)
-
-
-def _column_problem(run: Run, data: dict, columns) -> str:
-    missing = [c for c in columns if c not in data]
-    if not data:
-        return "no series.h5"
-    return f"series.h5 has no column {', '.join(missing)}" if missing else ""
-
-
-def _check_proximity(check_: StatementCheck, claim: dict, runs: list[Run], cache: dict) -> None:
-    spec = claim["check"]
-    body, other, column = spec.get("body"), spec.get("other"), spec.get("column", "drag_coefficient")
-    columns = [f"{body}.x", f"{other}.x", f"{body}.{column}"]
-    for run in runs:
-        if run.status != "ok":
-            check_.parts.append(_not_ok(run))
-            continue
-        data = series(run, cache)
-        problem = _column_problem(run, data, ["t"] + columns)
-        if problem:
-            check_.parts.append(Part(label(run), run.anchor, problem))
-            continue
-        prox = proximity_means(data["t"], data[columns[0]], data[columns[1]], data[columns[2]], spec)
-        base = prox.baseline
-        if prox.problem:
-            check_.parts.append(Part(label(run), run.anchor, prox.problem))
-            continue
-        lines = [f"baseline ({base.text}): mean {base.mean:.4g} over {base.samples} samples, "
-                 f"t = {base.t_span[0]:g}–{base.t_span[1]:g}"]
-        for w in prox.windows:
-            if w.mean is None:
-                lines.append(f"{w.name} ({w.text}): fewer than {MIN_SAMPLES} samples")
+def check_statements(claims: list[dict], runs: list[Run], claims_file: Path | None = None,
+                     settings: dict | None = None, only: str | None = None) -> list[StatementCheck]:
+    """The verdicts of ``caplab claims`` (claims.py) on ``runs`` for the statements ``claims`` of
+    ``claims_file`` (``--only``: ``only``); without a file, on a document of ``claims`` with
+    ``settings`` (provenance.json "consistency") beside it. Runs without a directory are about none."""
+    t_from = start_left_out(settings)
+    checks = {c.get("id"): StatementCheck(c, describe(c, t_from), _group(c)) for c in claims}
+    by_dir = {str(r.directory.resolve()): r for r in runs if r.directory is not None}
+    if by_dir:
+        with tempfile.TemporaryDirectory(prefix="caplab-moving-claims-") as tmp:
+            if claims_file is None:  # the start left out is read from the provenance.json beside the claims
+                claims_file = Path(tmp) / CLAIMS_FILE
+                claims_file.write_text(json.dumps({"claims": claims}), encoding="utf-8")
+                (Path(tmp) / "provenance.json").write_text(json.dumps({"consistency": settings or {}}),
+                                                           encoding="utf-8")
+            result = claims_tool.evaluate(claims_file, [Path(d) for d in by_dir], only)
+        for out in result.get("claims", []):
+            check = checks.get(out.get("id"))
+            if check is None:
                 continue
-            lines.append(f"{w.name} ({w.text}): mean {w.mean:.4g} over {w.samples} samples, "
-                         f"t = {w.t_span[0]:g}–{w.t_span[1]:g}, "
-                         f"{'above' if w.mean > base.mean else 'below'} the baseline ({w.mean - base.mean:+.3g}; "
-                         f"the statement: {w.expect}) {'✓' if w.ok else '✗'}; "
-                         f"max {w.peak[0]:.4g} at dx = {w.peak[1]:.3g}, "
-                         f"min {w.trough[0]:.4g} at dx = {w.trough[1]:.3g}")
-        sign = "C_d" if prox.sign > 0 else "−C_d"
-        lines.append(f"closest approach (dx = 0) at t = {prox.encounter:.4g}; the drag opposing the motion is {sign} "
-                     f"(the {body} body moves along {'−' if prox.sign > 0 else '+'}x)")
-        text = ", ".join(f"{w.name}: {num(w.mean)}" for w in [base] + prox.windows)
-        check_.parts.append(Part(label(run), run.anchor, text, prox.ok, lines))
+            check.verdict = out.get("verdict") or "not checked"
+            check.note = str(out.get("message") or "")
+            check.parts = [_part(row, by_dir) for row in out.get("runs", [])]
+    for check in checks.values():
+        if check.verdict == "no run" and not check.note:
+            check.note = "no run of " + ", ".join(sorted(check.claim.get("cases") or []))
+    return list(checks.values())
 
 
-def _twin_parts(claim: dict, runs: list[Run], all_runs: list[Run], cache: dict, t_from: float) -> list[Part]:
-    columns, tolerance = list(claim["check"].get("columns") or []), float(claim["upper"])
-    parts = []
-    for run in runs:
-        if run.status != "ok":
-            parts.append(_not_ok(run))
-            continue
-        twin = twin_of(run, all_runs)
-        if twin is None:
-            parts.append(Part(label(run), run.anchor, f"no uniform-grid twin run at fidelity {run.fidelity}"))
-            continue
-        if twin.status != "ok":
-            parts.append(Part(label(run), run.anchor, f"twin {twin.case_id}: {_not_ok(twin).text}"))
-            continue
-        parts.append(_difference_part(run, twin, columns, t_from, tolerance, cache, "twin"))
-    return parts
+def check_statement(claim: dict, runs: list[Run], cache: dict | None = None, settings: dict | None = None) -> StatementCheck:
+    """``check_statements`` for one statement (``cache`` is not used: caplab reads the series)."""
+    return check_statements([claim], runs, settings=settings)[0]
 
 
-def _difference_part(run: Run, ref: Run, columns: list[str], t_from: float, tolerance: float, cache: dict,
-                     what: str) -> Part:
-    a, b = series(run, cache), series(ref, cache)
-    problem = _column_problem(run, a, ["t"] + columns) or _column_problem(ref, b, ["t"] + columns)
-    if problem:
-        return Part(label(run), run.anchor, problem)
-    diffs = [relative_rms(a["t"], a[c], b["t"], b[c], t_from, c) for c in columns]
-    if any(d is None for d in diffs):
-        return Part(label(run), run.anchor, f"the series of the {what} do not overlap after t = {t_from:g}")
-    ok = all(finite(d.relative) and d.relative <= tolerance for d in diffs)
-    text = "; ".join(f"{symbol(d.column)} {pct(d.relative)}" for d in diffs) + f" (at most {pct(tolerance)})"
-    lines = [f"against {label(ref)}, t ≥ {t_from:g}: "
-             + "; ".join(f"{symbol(d.column)}: RMS {d.rms:.3g} over peak {d.peak:.4g} = {pct(d.relative)} "
-                         f"({d.samples} samples)" for d in diffs)]
-    differs = numerics_differences(run, ref)
-    if differs:
-        lines.append("the runs also differ in numerics." + ", numerics.".join(differs))
-    return Part(label(run), run.anchor, text, ok, lines)
-
-
-def _check_refinement(check_: StatementCheck, claim: dict, runs: list[Run], cache: dict, t_from: float) -> None:
-    columns, tolerance = list(claim["check"].get("columns") or []), float(claim["upper"])
-    for run in runs:
-        if run.status != "ok":
-            check_.parts.append(_not_ok(run))
-    by_case: dict[str, list[Run]] = {}
-    for run in runs:
-        if run.status == "ok" and refinement(run) == "two_level" and run.fine_spacing is not None:
-            by_case.setdefault(run.case_id, []).append(run)
-    for members in by_case.values():
-        members.sort(key=lambda r: -r.fine_spacing)
-        finest = members[-1]
-        coarser = [r for r in members if r.fine_spacing > finest.fine_spacing * (1 + 1e-9)]
-        if not coarser:
-            grids = ", ".join(f"Δx_f = {r.fine_spacing:g} ({r.fidelity})" for r in members)
-            check_.parts.append(Part(label(finest), finest.anchor,
-                                     f"one grid only ({grids}): nothing to refine against"))
-            continue
-        for run in coarser:
-            part = _difference_part(run, finest, columns, t_from, tolerance, cache, "grids")
-            part.details.insert(0, f"Δx_f = {run.fine_spacing:g} against the finer Δx_f = {finest.fine_spacing:g} "
-                                   "(self-reference)")
-            check_.parts.append(part)
-
-
-def _check_fine_fraction(check_: StatementCheck, claim: dict, runs: list[Run], all_runs: list[Run]) -> None:
-    spec = claim["check"]
-    value, tolerance = float(claim["value"]), float(spec["tolerance"])
-    compare_with = spec.get("compare_with")
-    for run in runs:
-        if run.status != "ok":
-            check_.parts.append(_not_ok(run))
-            continue
-        f = fine_fraction(run.case)
-        built = built_fine_fraction(run.manifest)
-        if f is None:
-            check_.parts.append(Part(label(run), run.anchor, "the case has no fine block (numerics.grid.fine_region)"))
-        else:
-            ok = abs(f - value) <= tolerance
-            check_.parts.append(Part(f"{label(run)}: fine fraction", run.anchor,
-                                     f"{pct(f)} as set, {pct(built) if built is not None else '–'} as built "
-                                     f"(thesis {100 * value:g} %, within {100 * tolerance:g} %)", ok,
-                                     ["as set: numerics.grid.fine_region over physics.domain.size; as built: the fine "
-                                      "block's node extent over the coarse block's (manifest lattice.blocks)"]))
-        twin = twin_of(run, all_runs)
-        if twin is None or twin.status != "ok":
-            check_.parts.append(Part(f"{label(run)}: cost", run.anchor,
-                                     f"no finished uniform-grid twin at fidelity {run.fidelity}"))
-            continue
-        c = cost(run, twin)
-        if c.node_ratio is None:
-            check_.parts.append(Part(f"{label(run)}: cost", run.anchor, "no lattice.node_updates in the manifests"))
-            continue
-        check_.parts.append(Part(
-            f"{label(run)}: effort saved", run.anchor,
-            f"node updates twin/two-block {c.node_ratio:.3g} (saving {pct(Cost.saving(c.node_ratio))}); "
-            f"wall time {num(c.wall_ratio, 3)} (saving {pct(Cost.saving(c.wall_ratio))}, not judged: noisy)",
-            c.node_ratio > 1.0,
-            [f"node updates {c.nodes[0]:.4g} (two-block) and {c.nodes[1]:.4g} ({twin.case_id}); wall time "
-             f"{num(c.walls[0])} s and {num(c.walls[1])} s on {c.threads[0]} and {c.threads[1]} thread(s): wall time "
-             "depends on the machine and its load"]))
-        if not compare_with:
-            continue
-        other = next((r for r in all_runs if r.case_id == compare_with and r.fidelity == run.fidelity
-                      and r.status == "ok"), None)
-        other_twin = twin_of(other, all_runs) if other is not None else None
-        oc = cost(other, other_twin) if other_twin is not None and other_twin.status == "ok" else None
-        if oc is None or oc.node_ratio is None:
-            check_.parts.append(Part(f"{label(run)}: less than section 2.2.1", run.anchor,
-                                     f"no finished pair {compare_with} + uniform twin at fidelity {run.fidelity}"))
-            continue
-        here, there = Cost.saving(c.node_ratio), Cost.saving(oc.node_ratio)
-        check_.parts.append(Part(f"{label(run)}: less than section 2.2.1", run.anchor,
-                                 f"saving {pct(here)} against {pct(there)} for {compare_with} (node updates)",
-                                 here < there))
+def _group(claim: dict) -> str:
+    spec = claim.get("check") if isinstance(claim.get("check"), dict) else {}
+    return "flow" if spec.get("type") == "proximity_means" else "method"
 
 
 def start_left_out(settings: dict | None) -> float:
@@ -636,38 +503,6 @@ def start_left_out(settings: dict | None) -> float:
     entry = (settings or {}).get("twin_difference")
     value = entry.get("from") if isinstance(entry, dict) else None
     return float(value) if finite(value) else 0.0
-
-
-def check_statement(claim: dict, runs: list[Run], cache: dict | None = None, settings: dict | None = None) -> StatementCheck:
-    """Confronts one statement of references/moving/claims.json with the runs (see the module doc);
-    ``settings``: the "consistency" entries of references/moving/provenance.json."""
-    cache = {} if cache is None else cache
-    t_from = start_left_out(settings)
-    spec = claim.get("check") if isinstance(claim.get("check"), dict) else {}
-    kind = spec.get("type")
-    cases = set(claim.get("cases") or [])
-    about = sorted((r for r in runs if r.case_id in cases), key=lambda r: (r.case_id, r.fidelity))
-    what = describe(claim, t_from)
-    check_ = StatementCheck(claim, what, "flow" if kind == "proximity_means" else "method")
-    try:
-        if kind == "proximity_means":
-            _check_proximity(check_, claim, about, cache)
-        elif kind == "twin":
-            check_.parts = _twin_parts(claim, about, runs, cache, t_from)
-        elif kind == "refinement":
-            _check_refinement(check_, claim, about, cache, t_from)
-        elif kind == "fine_fraction":
-            _check_fine_fraction(check_, claim, about, runs)
-        else:
-            check_.note = f"unknown check type {kind!r}"
-    except (KeyError, TypeError, ValueError) as err:  # a malformed claim: say so, do not stop the report
-        check_.parts = []
-        check_.note = f"malformed check in claims.json: {err!r}"
-    check_.verdict, partial = _verdict(check_.parts)
-    check_.note = "; ".join(x for x in (check_.note, partial) if x)
-    if not about:
-        check_.note = "; ".join(x for x in (check_.note, "no run of " + ", ".join(sorted(cases))) if x)
-    return check_
 
 
 def describe(claim: dict, t_from: float = 0.0) -> str:
@@ -1115,9 +950,18 @@ def build(runs: list[Run], refs: ReferenceLibrary, chapter: str) -> Moving:
     section.consistency = prov.get("consistency") if isinstance(prov.get("consistency"), dict) else {}
     used = {}
     claims = [(ds, c) for ds, c in refs.claims(chapter + ".") if ds.benchmark == BENCHMARK]
+    by_file: dict[str, tuple] = {}
     for ds, claim in claims:
-        section.statements.append(check_statement(claim, runs, cache, section.consistency))
+        by_file.setdefault(ds.anchor, (ds, []))[1].append(claim)
         used[ds.anchor] = ds
+    for ds, file_claims in by_file.values():
+        try:
+            section.statements += check_statements(file_claims, runs, ds.path, section.consistency, chapter + ".")
+        except claims_tool.ClaimsUnavailable as err:
+            section.problems.append(f"thesis statements of {ds.rel} not checked: {err}")
+            t_from = start_left_out(section.consistency)
+            section.statements += [StatementCheck(c, describe(c, t_from), _group(c), verdict="not checked",
+                                                  note=str(err)) for c in file_claims]
     section.twin_from = start_left_out(section.consistency)
     twin_claims = [c for _, c in claims if (c.get("check") or {}).get("type") == "twin"]
     proximity = [c for _, c in claims if (c.get("check") or {}).get("type") == "proximity_means"]

@@ -6,7 +6,8 @@ Two kinds of fixture: moving_runs/ holds five finished quick runs of the catalog
 cylinders, the hovering wing, their uniform-grid twins and the Wang 2004 wing; series.h5 cut down
 to the columns the report uses, see moving_runs/README.md), so that the numbers the report
 computes are checked on real output; and hand-built runs with made-up series, so that every check
-is shown to fail where it must."""
+is shown to fail where it must. The statements are checked by the built caplab (`caplab claims`,
+solver/score/motion_claims.hpp; reports/caplab_report/claims.py finds it): `make build` first."""
 
 from __future__ import annotations
 
@@ -116,7 +117,7 @@ def test_pages_hold_the_section_apart_from_the_capsules(built):
 
 def test_drag_trend_as_defined_fails_on_the_quick_runs(built):
     row = claim_row(built["html"]["chapter2"], "ch2.two_cylinders.drag_trend")
-    assert "FAIL" in row
+    assert "INCONSISTENT" in row
     assert "From the results it is seen that the drag force increases" in row
     assert "The windows are caplab's choice" in row  # how the windows were chosen, said on the page
     assert "baseline: 1.86, approaching in close proximity: 1.585, moving away in close proximity: 1.558" in row
@@ -128,14 +129,15 @@ def test_drag_trend_as_defined_fails_on_the_quick_runs(built):
 def test_method_statements_on_the_quick_runs(built):
     html = built["html"]["chapter2"]
     twin = claim_row(html, "ch2.two_cylinders.uniform_twin")
-    assert "FAIL" in twin and "upper C_d 1.78 %; upper C_l 3.50 % (at most 2.00 %)" in twin
+    assert "INCONSISTENT" in twin and "upper C_d 1.78 %; upper C_l 3.50 % (at most 2.00 %)" in twin
     wing = claim_row(html, "ch2.hovering_wing.twin")
-    assert "PASS" in wing and "C_d 0.44 %; C_l 0.36 %" in wing and "derived" in wing
+    assert "CONSISTENT" in wing and "C_d 0.44 %; C_l 0.36 %" in wing and "derived" in wing
     fraction = claim_row(html, "ch2.two_cylinders.fine_fraction")
-    assert "PASS" in fraction and "24.06 % as set, 23.79 % as built (thesis 24.1 %" in fraction
+    assert "CONSISTENT" in fraction and "24.06 % as set, 23.79 % as built (thesis 24.1 %" in fraction
     assert "node updates twin/two-block 2.75 (saving 63.60 %)" in fraction and "not judged: noisy" in fraction
     assert "no finished pair ch2/cylinder_re100 + uniform twin at fidelity quick" in fraction
-    assert "NOT RUN" in claim_row(html, "ch2.hovering_wing.refinement")
+    refinement = claim_row(html, "ch2.hovering_wing.refinement")
+    assert "NOT ENOUGH RUNS" in refinement and "one grid only" in refinement
 
 
 def test_verification_tables_on_the_quick_runs(built):
@@ -162,16 +164,17 @@ def test_numbers_of_the_quick_runs():
     runs = list(fixture_runs().values())
     c = claims()
     trend = judge(c["ch2.two_cylinders.drag_trend"], runs)
-    assert trend.verdict == "fail" and len(trend.parts) == 2
+    assert trend.verdict == "inconsistent" and len(trend.parts) == 2 and trend.parts[0].ok is False
     r = {run.case_id: run for run in runs}
     d = moving.series(r["ch2/two_cylinders_re40"], {})
     prox = moving.proximity_means(d["t"], d["upper.x"], d["lower.x"], d["upper.drag_coefficient"],
                                   c["ch2.two_cylinders.drag_trend"]["check"])
     assert prox.encounter == pytest.approx(24.0, abs=0.01) and prox.sign == 1.0
     assert prox.baseline.mean == pytest.approx(1.8605, abs=1e-4) and prox.baseline.samples == 40
-    approaching, separating = prox.windows
-    assert approaching.mean == pytest.approx(1.5851, abs=1e-4) and approaching.ok is False
-    assert separating.mean == pytest.approx(1.5582, abs=1e-4) and separating.ok is True
+    approaching, separating = prox.windows  # the means of the figure are the ones caplab judged
+    assert approaching.mean == pytest.approx(1.5851, abs=1e-4) and separating.mean == pytest.approx(1.5582, abs=1e-4)
+    assert "mean 1.585 over 30 samples" in trend.parts[0].details[1] and "✗" in trend.parts[0].details[1]
+    assert "mean 1.558 over 30 samples" in trend.parts[0].details[2] and "✓" in trend.parts[0].details[2]
     tw = moving.twin_of(r["ch2/two_cylinders_re40"], runs)
     assert tw is r["ch2/two_cylinders_re40_uniform"]
     e = moving.series(tw, {})
@@ -235,19 +238,19 @@ def test_proximity_check_passes_and_fails(tmp_path):
     case = fixture_case("ch2/two_cylinders_re40")
     good = write_run(tmp_path / "good", case, cylinders(T, bump_drag(2.2, 1.2)))
     result = judge(claim, [good])
-    assert result.verdict == "pass", result.parts
+    assert result.verdict == "consistent", result.parts
     for approach, separation in ((1.5, 1.2), (2.2, 2.0), (1.8, 1.2)):  # no rise; no fall; equal is not above
         bad = write_run(tmp_path / f"bad{approach}{separation}", case, cylinders(T, bump_drag(approach, separation)))
-        assert judge(claim, [bad]).verdict == "fail", (approach, separation)
+        assert judge(claim, [bad]).verdict == "inconsistent", (approach, separation)
     # the bodies never pass each other: nothing to judge
     columns = cylinders(T, bump_drag(2.2, 1.2))
     columns["lower.x"] = columns["lower.x"] - 40
     stuck = write_run(tmp_path / "stuck", case, columns)
     result = judge(claim, [stuck])
-    assert result.verdict == "not run" and "never changes sign" in result.parts[0].text
-    # a missing run is not run
+    assert result.verdict == "not checked" and "never changes sign" in result.parts[0].text
+    # a missing run (no directory) is about nothing
     missing = Run(case_id=case["id"], fidelity="quick", case=case, status="missing")
-    assert judge(claim, [missing]).verdict == "not run"
+    assert judge(claim, [missing]).verdict == "no run"
 
 
 def test_opposing_drag_follows_the_direction_of_motion():
@@ -257,7 +260,7 @@ def test_opposing_drag_follows_the_direction_of_motion():
             "windows": [{"name": "a", "dx": "[-3, 0)", "phase": "approaching", "expect": "above"},
                         {"name": "s", "dx": "(0, 3]", "phase": "separating", "expect": "below"}]}
     prox = moving.proximity_means(T, columns["lower.x"], columns["upper.x"], columns["lower.drag_coefficient"], spec)
-    assert prox.sign == -1.0 and prox.baseline.mean == pytest.approx(1.8) and prox.ok is True
+    assert prox.sign == -1.0 and prox.baseline.mean == pytest.approx(1.8)
     assert [w.mean for w in prox.windows] == [pytest.approx(2.2), pytest.approx(1.2)]
     with pytest.raises(ValueError):
         moving.proximity_means(T, columns["lower.x"], columns["upper.x"], columns["lower.drag_coefficient"],
@@ -301,10 +304,10 @@ def test_twin_check_and_pairing(tmp_path):
     same = write_run(tmp_path / "b", uni, cylinders(T, drag), node_updates=3e9)
     assert moving.twin_of(a, [a, same]) is same and moving.twin_of(same, [a, same]) is None
     result = judge(claim, [a, same])
-    assert result.verdict == "pass" and "upper C_l 0.00 %" in result.parts[0].text
+    assert result.verdict == "consistent" and "upper C_l 0.00 %" in result.parts[0].text
     off = write_run(tmp_path / "c", uni, cylinders(T, drag, lift_offset=0.05))  # 0.05 over the peak 0.55
     result = judge(claim, [a, off])
-    assert result.verdict == "fail" and "upper C_l 9.09 %" in result.parts[0].text
+    assert result.verdict == "inconsistent" and "upper C_l 9.09 %" in result.parts[0].text
     # not a twin: other physics, other fine spacing, other fidelity
     other = copy.deepcopy(uni)
     other["physics"]["reynolds"] = 41
@@ -312,7 +315,7 @@ def test_twin_check_and_pairing(tmp_path):
     coarser["numerics"]["grid"]["fine_spacing"] = 0.05
     runs = [a, write_run(tmp_path / "d", other, cylinders(T, drag)), write_run(tmp_path / "e", coarser, cylinders(T, drag))]
     assert moving.twin_of(a, runs) is None
-    assert judge(claim, runs).verdict == "not run"
+    assert judge(claim, runs).verdict == "not enough runs"
     standard = load_run(tmp_path / "b", uni["id"], "standard")
     assert moving.twin_of(a, [a, standard]) is None
 
@@ -324,10 +327,10 @@ def test_fine_fraction_and_cost_checks(tmp_path):
     a = write_run(tmp_path / "a", two, cols, node_updates=1e9)
     b = write_run(tmp_path / "b", uni, cols, node_updates=3e9)
     result = judge(claim, [a, b])
-    assert result.verdict == "pass" and [p.ok for p in result.parts] == [True, True, None]
+    assert result.verdict == "consistent" and [p.ok for p in result.parts] == [True, True, None]
     # the uniform grid cheaper than the two-block one: no saving
     cheap = write_run(tmp_path / "c", uni, cols, node_updates=0.5e9)
-    assert judge(claim, [a, cheap]).verdict == "fail"
+    assert judge(claim, [a, cheap]).verdict == "inconsistent"
     # a fine block of another size than the thesis's 24.1 %
     bigger = copy.deepcopy(two)
     bigger["numerics"]["grid"]["fine_region"]["max"] = [28, 11.6]
@@ -343,7 +346,7 @@ def test_fine_fraction_and_cost_checks(tmp_path):
         p = write_run(tmp_path / f"cyl{ratio}", cyl, cyl_cols, node_updates=1e9)
         q = write_run(tmp_path / f"cyl{ratio}u", cyl_uni, cyl_cols, node_updates=ratio * 1e9)
         result = judge(claim, [a, b, p, q])
-        assert result.parts[-1].ok is ok and result.verdict == ("pass" if ok else "fail"), result.parts[-1].text
+        assert result.parts[-1].ok is ok and result.verdict == ("consistent" if ok else "inconsistent"), result.parts[-1].text
 
 
 def test_refinement_check(tmp_path):
@@ -355,11 +358,11 @@ def test_refinement_check(tmp_path):
     finer["numerics"]["grid"]["fine_spacing"] = case["numerics"]["grid"]["fine_spacing"] / 2
     a = write_run(tmp_path / "a", case, base)
     b = load_run(write_run(tmp_path / "b", finer, base).directory, case["id"], "standard")
-    assert judge(claim, [a]).verdict == "not run"
-    assert judge(claim, [a, b]).verdict == "pass"
+    assert judge(claim, [a]).verdict == "not enough runs"
+    assert judge(claim, [a, b]).verdict == "consistent"
     c = load_run(write_run(tmp_path / "c", finer, dict(base, drag_coefficient=1.2 * np.cos(0.8 * t))).directory,
                  case["id"], "standard")
-    assert judge(claim, [a, c]).verdict == "fail"
+    assert judge(claim, [a, c]).verdict == "inconsistent"
 
 
 def test_periodicity_and_period_means():
