@@ -41,12 +41,17 @@ def executable() -> Path:
     return chosen
 
 
-def evaluate(claims: Path | dict, run_dirs: list[Path], only: str | None = None) -> dict:
-    """``caplab claims`` on the claims file (or document) ``claims`` and the run directories."""
+def evaluate(claims: Path | dict, run_dirs: list[Path], only: str | None = None,
+             provenance: dict | None = None) -> dict:
+    """``caplab claims`` on the claims file (or document) ``claims`` and the run directories. For a
+    document, ``provenance`` is written beside it as the provenance.json caplab reads settings from
+    (e.g. "consistency" of references/moving); a file has its own."""
     with tempfile.TemporaryDirectory(prefix="caplab-claims-") as tmp:
         if isinstance(claims, dict):
             path = Path(tmp) / "claims.json"
             path.write_text(json.dumps(claims), encoding="utf-8")
+            if provenance is not None:
+                (Path(tmp) / "provenance.json").write_text(json.dumps(provenance), encoding="utf-8")
         else:
             path = Path(claims)
         out = Path(tmp) / "result.json"

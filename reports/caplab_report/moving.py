@@ -37,7 +37,6 @@ import copy
 import json
 import math
 import re
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -468,13 +467,8 @@ def check_statements(claims: list[dict], runs: list[Run], claims_file: Path | No
     checks = {c.get("id"): StatementCheck(c, describe(c, t_from), _group(c)) for c in claims}
     by_dir = {str(r.directory.resolve()): r for r in runs if r.directory is not None}
     if by_dir:
-        with tempfile.TemporaryDirectory(prefix="caplab-moving-claims-") as tmp:
-            if claims_file is None:  # the start left out is read from the provenance.json beside the claims
-                claims_file = Path(tmp) / CLAIMS_FILE
-                claims_file.write_text(json.dumps({"claims": claims}), encoding="utf-8")
-                (Path(tmp) / "provenance.json").write_text(json.dumps({"consistency": settings or {}}),
-                                                           encoding="utf-8")
-            result = claims_tool.evaluate(claims_file, [Path(d) for d in by_dir], only)
+        result = claims_tool.evaluate(claims_file or {"claims": claims}, [Path(d) for d in by_dir], only,
+                                      provenance={"consistency": settings or {}})
         for out in result.get("claims", []):
             check = checks.get(out.get("id"))
             if check is None:
