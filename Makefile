@@ -34,7 +34,10 @@ test: build
 reproduce: build
 	@scripts/reproduce --caplab $(CAPLAB) --fidelity $(or $(FIDELITY),quick) --results $(RESULTS) catalogue
 
-reproduce-chapter%: build
+# A static pattern rule: make skips implicit (pattern) rules for .PHONY targets, so a plain
+# `reproduce-chapter%:` rule made `make reproduce-chapter2` do nothing at all.
+CHAPTER_TARGETS := reproduce-chapter2 reproduce-chapter3 reproduce-chapter4 reproduce-chapter5 reproduce-chapter6
+$(CHAPTER_TARGETS): reproduce-chapter%: build
 	@scripts/reproduce --caplab $(CAPLAB) --fidelity $(or $(FIDELITY),standard) --results $(RESULTS) catalogue/ch$*
 
 reproduce-extra: build

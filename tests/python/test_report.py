@@ -341,3 +341,19 @@ def test_reproduce_jobs(reproduce_env):
     assert proc.returncode == 1 and count() == 4
     assert len(re.findall(r"^\[\d/4\]", proc.stdout, re.M)) == 4
 
+
+
+@pytest.mark.parametrize("target, folder, fidelity", [
+    ("reproduce", "catalogue", "quick"),
+    ("reproduce-chapter2", "catalogue/ch2", "standard"),
+    ("reproduce-chapter6", "catalogue/ch6", "standard"),
+    ("reproduce-extra", "catalogue/extra", "standard"),
+])
+def test_make_reproduce_targets_run_their_cases(target, folder, fidelity):
+    """`make -n`: each reproduce target runs scripts/reproduce on its folder (make skips pattern
+    rules for .PHONY targets, which once made `make reproduce-chapter2` do nothing)."""
+    out = subprocess.run(["make", "-n", target], cwd=REPO, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    runs = [line for line in out.stdout.splitlines() if "scripts/reproduce" in line]
+    assert len(runs) == 1, out.stdout
+    assert runs[0].endswith(f" {folder}") and f"--fidelity {fidelity}" in runs[0], runs[0]
