@@ -40,6 +40,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib import ticker  # noqa: E402
 
 from .figures import png_data_uri  # noqa: E402
 from .references import ReferenceLibrary  # noqa: E402
@@ -257,7 +258,7 @@ _LABEL = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
 _TOP_KEYS = {"description", "families"}
 _FAMILY_KEYS = {"id", "title", "description", "case", "fidelity", "resolution", "metrics", "points"}
 _METRIC_KEYS = {"name", "symbol", "references"}
-_POINT_KEYS = {"label", "set", "fidelity", "level", "quick", "note"}
+_POINT_KEYS = {"label", "set", "case", "fidelity", "level", "quick", "note"}
 _REF_KEYS = {"external": {"kind", "value", "source", "label"},
              "richardson": {"kind", "over", "points", "quick_points", "order", "label"}}
 
@@ -343,6 +344,12 @@ def load_series(path: Path, repo: Path | None = None, data: dict | None = None) 
                     raise _fail(path, f"{pat}/set/{k}", "expected a dotted case path such as numerics.end_time", k)
                 if v is None or isinstance(v, dict):
                     raise _fail(path, f"{pat}/set/{k}", "expected a number, string, boolean or list", v)
+            if "case" in p:
+                own = text(p, "case", pat)
+                if not (repo / own).is_file():
+                    raise _fail(path, f"{pat}/case", f"no such case file under {repo}", own)
+                if "level" in p:
+                    raise _fail(path, f"{pat}/case", "a catalogue level point runs the family's case", own)
             p.setdefault("fidelity", fam["fidelity"])
             if p["fidelity"] not in LEVELS:
                 raise _fail(path, f"{pat}/fidelity", f"expected one of {', '.join(LEVELS)}", p["fidelity"])
@@ -414,6 +421,11 @@ def load_series(path: Path, repo: Path | None = None, data: dict | None = None) 
 def point_overrides(point: dict) -> list[str]:
     """The ``--set`` arguments of a point, in the file's order: path=JSON value."""
     return [f"{k}={json.dumps(v)}" for k, v in point.get("set", {}).items()]
+
+
+def point_case_file(family: dict, point: dict) -> str:
+    """The case file of a point, relative to the repository: its own "case", else the family's."""
+    return point.get("case") or family["case"]
 
 
 def points_of(family: dict, quick: bool) -> list[dict]:
@@ -522,9 +534,10 @@ def read_point(family: dict, point: dict, results: Path) -> PointResult:
     stamp = stamp if isinstance(stamp, dict) else {}
     manifest = manifest if isinstance(manifest, dict) else {}
     code, status = stamp.get("exit_code"), manifest.get("status")
-    if stamp and (stamp.get("overrides", []) != point_overrides(point) or stamp.get("fidelity") != point["fidelity"]):
-        res.state, res.message = "stale", ("the series file changed since this point ran (overrides or fidelity "
-                                           "differ from its stamp): rerun scripts/bench-error")
+    if stamp and (stamp.get("overrides", []) != point_overrides(point) or stamp.get("fidelity") != point["fidelity"]
+                  or not str(stamp.get("case_file", "")).endswith(point_case_file(family, point))):
+        res.state, res.message = "stale", ("the series file changed since this point ran (case, overrides or "
+                                           "fidelity differ from its stamp): rerun scripts/bench-error")
     elif status == "ok" and code in (0, 1, None):
         res.state = "ok"
     elif stamp and code is None:
@@ -643,7 +656,7 @@ def error_figure(view: dict) -> str | None:
             if not pts:
                 continue
             xs = [float(r.wall) for r in pts]
-            ys = [max(r.errors[key], floor) for r in pts]
+            ys = [100 * max(r.errors[key], floor) for r in pts]
             ax.plot(xs, ys, marker, color=colour, mfc=colour if filled else "none", ms=6, ls="none",
                     label=f"vs {rv['label']}")
             front = sorted((r for r in pts if key in r.front), key=lambda r: float(r.wall))
@@ -654,7 +667,7 @@ def error_figure(view: dict) -> str | None:
                         fx.append(float(r.wall))
                         fy.append(fy[-1])
                     fx.append(float(r.wall))
-                    fy.append(max(r.errors[key], floor))
+                    fy.append(100 * max(r.errors[key], floor))
                 ax.plot(fx, fy, "--", color=colour, lw=1.0, alpha=0.8)
             for r, x, y in zip(pts, xs, ys):
                 text = r.label + (f" [{r.level}]" if r.level else "")
@@ -664,8 +677,12 @@ def error_figure(view: dict) -> str | None:
                     ax.plot([x], [y], "o", ms=13, mfc="none", mec="#333", lw=0.8)
         ax.set_xscale("log")
         ax.set_yscale("log")
+        for axis in (ax.xaxis, ax.yaxis):
+            axis.set_major_locator(ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+            axis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+            axis.set_minor_formatter(ticker.NullFormatter())
         ax.set_xlabel("wall time [s]")
-        ax.set_ylabel(f"relative error of {m['symbol']}")
+        ax.set_ylabel(f"relative error of {m['symbol']} [%]")
         ax.grid(True, which="both", lw=0.3, alpha=0.6)
         ax.legend(fontsize=7, loc="best")
         ax.set_title(m["symbol"], fontsize=10)
@@ -719,8 +736,14 @@ class Page:
     problems: list[str] = field(default_factory=list)
 
 
-def fmt_pct(v, digits: int = 3) -> str:
-    return f"{100 * float(v):.{digits}g} %" if _num(v) else "–"
+def fmt_pct(v, decimals: int = 1) -> str:
+    """0.8123 -> "81.2 %" (fixed decimals, never an exponent)."""
+    return f"{100 * float(v):.{decimals}f} %" if _num(v) else "–"
+
+
+def fmt_error_pct(v) -> str:
+    """A relative error in percent with three significant digits: 0.000123 -> "0.0123 %"."""
+    return f"{100 * float(v):.3g} %" if _num(v) else "–"
 
 
 def render(bench: dict | None, stages: list[dict], error: dict, meta: dict, bench_problem: str = "") -> str:
@@ -728,6 +751,7 @@ def render(bench: dict | None, stages: list[dict], error: dict, meta: dict, benc
 
     env = environment()
     env.filters["pct"] = fmt_pct
+    env.filters["errpct"] = fmt_error_pct
     b = bench or {}
     return env.get_template("bench.html.j2").render(
         title="caplab — performance (make bench)", bench=b, bench_problem=bench_problem,
