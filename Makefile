@@ -4,7 +4,9 @@
 #   make reproduce-extra      the external validations that are not thesis cases (catalogue/extra)
 #   make test                 unit + verification + short validation (what CI runs)
 #   make fuzz                 fuzz the case loader (opt-in clang build in build-fuzz; FUZZ_SECONDS=600)
-#   make bench | stress | report | clean
+#   make bench                bench.json + the page reports/out/bench/ (ERROR_SERIES=quick|full runs the error series first)
+#   make bench-error          the full run-time-against-error series (hours), then the bench page
+#   make stress | report | clean
 
 SHELL := /bin/bash
 BUILD ?= build
@@ -13,7 +15,7 @@ PYTHON := /usr/bin/python3
 CAPLAB := $(BUILD)/solver/app/caplab
 RESULTS ?= results
 
-.PHONY: all deps build test reproduce report bench stress clean \
+.PHONY: all deps build test reproduce report bench bench-error stress clean \
         reproduce-chapter2 reproduce-chapter3 reproduce-chapter4 reproduce-chapter5 reproduce-chapter6 \
         reproduce-extra
 
@@ -46,8 +48,21 @@ reproduce-extra: build
 report: build
 	@scripts/report --results $(RESULTS) --caplab $(CAPLAB)
 
+BENCH_OUT ?= reports/out/bench
+ERROR_RESULTS ?= $(RESULTS)/bench-error
+BENCH_ARGS ?=
+
+# make bench: caplab bench, then the page; the error series only when asked (it takes hours at
+# ERROR_SERIES=full; quick is a few minutes). A point that fails does not stop the page.
 bench: build
-	@$(CAPLAB) bench --out reports/out/bench
+	@$(CAPLAB) bench --out $(BENCH_OUT) $(BENCH_ARGS)
+	@$(if $(filter quick,$(ERROR_SERIES)),scripts/bench-error --caplab $(CAPLAB) --results $(ERROR_RESULTS) --quick --no-report || true)
+	@$(if $(filter full,$(ERROR_SERIES)),scripts/bench-error --caplab $(CAPLAB) --results $(ERROR_RESULTS) --no-report || true)
+	@PYTHONPATH=reports $(PYTHON) -m caplab_report.bench --bench $(BENCH_OUT)/bench.json --out $(BENCH_OUT) --results $(RESULTS) \
+	  --error-results $(ERROR_RESULTS) --error-mode $(or $(ERROR_SERIES),auto)
+
+bench-error: build
+	@scripts/bench-error --caplab $(CAPLAB) --results $(ERROR_RESULTS) --bench-out $(BENCH_OUT)
 
 stress: build
 	@scripts/stress --caplab $(CAPLAB) --out reports/out/stress

@@ -380,6 +380,7 @@ def build_report(results: Path, out: Path, references: Path | None = None, catal
         write_atomically(index, env.get_template("index.html.j2").render(
             title="caplab report — all chapters", runs=all_runs, chapters=chapter_links, counts=counts(all_runs),
             builds=builds, env_rows=env_rows, meta=meta, problems=result.problems, root="",
+            bench_page=(out / "bench" / "index.html").exists(),
             page_of=lambda r: f"{chapter_slug(r.chapter)}/index.html"))
         result.pages.append(index)
 
