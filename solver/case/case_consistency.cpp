@@ -324,6 +324,16 @@ void check_acceptance(const CaseSpec& spec, const std::vector<std::string>& leve
   }
 }
 
+// A budget may leave levels out (not judged there), but must not name a level the case lacks.
+void check_performance(const CaseSpec& spec, const std::vector<std::string>& levels,
+                       const CaseDiagnostics& diag) {
+  if (!spec.performance) return;
+  for (const auto& [level, budget] : spec.performance->wall_time_budget_s)
+    if (std::find(levels.begin(), levels.end(), level) == levels.end())
+      diag.fail_text("/performance/wall_time_budget_s/" + level, "budget for fidelity level \"" + level + "\"",
+                     "a level the case defines: " + quoted_list(levels) + did_you_mean(level, levels));
+}
+
 }  // namespace
 
 geometry::RingShape ring_shape(const ShapeSpec& shape) {
@@ -395,6 +405,7 @@ void check_consistency(const CaseSpec& spec, const std::vector<std::string>& lev
   check_bodies(spec, diag);
   check_outputs(spec, diag);
   check_acceptance(spec, levels, diag);
+  check_performance(spec, levels, diag);
 }
 
 }  // namespace caplab::cases

@@ -168,6 +168,12 @@ SchemaNode build_case_schema() {
       opt("window", array_of(number())),  // time_series only: [from, to] in L/U
       req("justification", text()),
   });
+  // A wall-time budget per fidelity level (some levels may have none): the scorer's performance
+  // verdict, kept out of the run's verdict (timings depend on the machine and its load).
+  const SchemaNode performance = object({
+      req("wall_time_budget_s", map_of(number(positive))),
+      req("justification", text()),
+  });
   return object({
       req("id", text()),
       req("title", text()),
@@ -178,6 +184,7 @@ SchemaNode build_case_schema() {
       req("fidelity", map_of(map_of(any()))),
       req("outputs", outputs),
       opt("acceptance", array_of(acceptance)),
+      opt("performance", performance),
   });
 }
 

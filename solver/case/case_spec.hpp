@@ -190,6 +190,13 @@ struct AcceptanceSpec {
   std::string justification;
 };
 
+/// The run's wall-time budget per fidelity level (levels without one are not judged), with the
+/// reason for it; judged by the scorer as the performance verdict, never as the run's verdict.
+struct PerformanceSpec {
+  std::map<std::string, double> wall_time_budget_s;
+  std::string justification;
+};
+
 struct CaseSpec {
   std::string source_file;  ///< where it was loaded from (for messages)
   std::string id, title, description;
@@ -198,6 +205,7 @@ struct CaseSpec {
   NumericsSpec numerics;
   OutputSpec outputs;
   std::vector<AcceptanceSpec> acceptance;
+  std::optional<PerformanceSpec> performance;
   nlohmann::json resolved;  ///< the fully resolved JSON (fidelity and overrides applied)
   nlohmann::json document;  ///< the case as read, before the level and the overrides (a resumed run reloads it)
   std::vector<std::string> overrides;  ///< the --set overrides, in order

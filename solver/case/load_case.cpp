@@ -321,6 +321,11 @@ CaseSpec to_spec(const json& doc, const CaseDiagnostics& diag) {
     entry.justification = a.at("justification").get<std::string>();
     spec.acceptance.push_back(std::move(entry));
   }
+  if (doc.contains("performance")) {
+    const json& p = doc.at("performance");
+    spec.performance = PerformanceSpec{p.at("wall_time_budget_s").get<std::map<std::string, double>>(),
+                                       p.at("justification").get<std::string>()};
+  }
   return spec;
 }
 

@@ -400,6 +400,34 @@ json accuracy(const std::string& status, const JsonFile& case_file, const JsonFi
 
 }  // namespace
 
+/// The performance verdict: the manifest's wall time against the case's budget at the run's level.
+json performance(const std::string& status, const json* manifest, const json* case_doc, const std::string& fidelity) {
+  json perf = json::object();
+  for (const char* key : {"wall_time_s", "mlups", "steps", "threads"})
+    perf[key] = manifest && manifest->contains(key) ? (*manifest)[key] : json(nullptr);
+  const json* spec = case_doc && case_doc->contains("performance") ? &(*case_doc)["performance"] : nullptr;
+  const json* budgets = spec && spec->is_object() && spec->contains("wall_time_budget_s")
+                            ? &(*spec)["wall_time_budget_s"] : nullptr;
+  const json budget = budgets && budgets->is_object() ? budgets->value(fidelity, json(nullptr)) : json(nullptr);
+  perf["budget_s"] = budget.is_number() ? budget : json(nullptr);
+  if (spec && spec->is_object() && (*spec).contains("justification")) perf["justification"] = (*spec)["justification"];
+  const json& wall = perf["wall_time_s"];
+  if (!budget.is_number()) {
+    perf["verdict"] = "not judged";
+    perf["reason"] = fmt::format("the case states no wall-time budget at level {}", fidelity.empty() ? "?" : fidelity);
+  } else if (status != "ok" || !wall.is_number()) {
+    perf["verdict"] = "not judged";
+    perf["reason"] = "the run did not finish (" + status + ")";
+  } else {
+    const double w = wall.get<double>(), b = budget.get<double>();
+    perf["verdict"] = w <= b ? "pass" : "fail";
+    perf["reason"] = fmt::format("wall time {:.4g} s {} the budget of {:.4g} s on {} thread(s); never part of the "
+                                 "run's verdict: it depends on the machine and its load",
+                                 w, w <= b ? "within" : "over", b, perf["threads"].dump());
+  }
+  return perf;
+}
+
 json evaluate_run(const fs::path& run_dir, const ScoreOptions& options) {
   if (!io::RunDirectory::is_run_directory(run_dir))
     throw core::InputError("'" + run_dir.string() +
@@ -432,10 +460,7 @@ json evaluate_run(const fs::path& run_dir, const ScoreOptions& options) {
   Context ctx{run_dir, options, fidelity, json::object(), RunSeries(run_dir / "series.h5")};
   score["accuracy"] = accuracy(status, case_file, summary, ctx);
 
-  json performance = json::object();
-  for (const char* key : {"wall_time_s", "mlups", "steps"})
-    performance[key] = m && m->contains(key) ? (*m)[key] : json(nullptr);
-  score["performance"] = std::move(performance);
+  score["performance"] = performance(status, m, c, fidelity);
 
   const bool pass = sane && score["accuracy"]["verdict"] != "fail";
   score["verdict"] = pass ? "pass" : "fail";

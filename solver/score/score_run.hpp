@@ -9,8 +9,11 @@
 //  - accuracy: each acceptance entry of case.json compared with its reference at the run's
 //    fidelity level (comparators.hpp); "none" (with a reason) for a run that is not "ok" or a
 //    case without acceptance entries;
-//  - performance: wall time, MLUPS, steps from the manifest — reported, never judged.
-// The overall verdict fails when sanity or accuracy fails.
+//  - performance: wall time, MLUPS, steps and threads from the manifest, judged against the
+//    case's "performance" "wall_time_budget_s" at the run's level: pass within it, fail over it,
+//    "not judged" without a budget at that level or for a run that did not finish.
+// The overall verdict fails when sanity or accuracy fails; performance never enters it (nor the
+// exit code of --strict): wall time depends on the machine, its load and the thread count.
 //
 // Acceptance entries read from case.json (light validation here; a malformed entry fails with
 // a message naming its JSON path, it never aborts scoring):
@@ -33,7 +36,8 @@
 //    "accuracy": {"verdict": pass|fail|none, "reason"?: "...", "entries": [{"metric","value",
 //                 "unit","reference_value","reference","comparison","error","tolerance",
 //                 "justification","verdict","message"?, "compared"?: {"from","to","points"}}]},
-//    "performance": {"wall_time_s","mlups","steps"}, "verdict": pass|fail}
+//    "performance": {"wall_time_s","mlups","steps","threads","budget_s","justification"?,
+//                    "verdict": pass|fail|not judged, "reason"}, "verdict": pass|fail}
 // A number that is not finite is written as null. For bracket entries "reference_value" is
 // [lo, hi]; for time_series entries "value" and "reference_value" are null; for mode entries
 // "value" is the metric's string, "reference_value" is "reference_mode" as written (a string or

@@ -95,9 +95,8 @@ std::string format_scorecard(const json& score) {
   }
 
   const json& perf = field(score, "performance");
-  out +=
-      fmt::format("performance (not judged): wall time {} s, {} MLUPS, {} steps\n",
-                  text(field(perf, "wall_time_s")), text(field(perf, "mlups")), text(field(perf, "steps")));
+  out += fmt::format("performance: {} ({}); {} MLUPS, {} steps\n", text(field(perf, "verdict")),
+                     text(field(perf, "reason")), text(field(perf, "mlups")), text(field(perf, "steps")));
   out += fmt::format("verdict: {}\n", text(field(score, "verdict")));
   return out;
 }

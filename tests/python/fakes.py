@@ -127,7 +127,13 @@ def make_run_dir(out: Path, case: dict, fidelity: str = "quick", outcome: str = 
                    "checks": [{"name": "status", "value": status, "limit": "ok", "verdict": "pass" if sane else "fail",
                                "message": "" if sane else "run diverged at t = 39.6 (NaN in the density)"}]},
         "accuracy": {"verdict": accuracy, "entries": entries, **({"reason": "run did not finish"} if not sane else {})},
-        "performance": {"wall_time_s": 42.5, "mlups": 31.7, "steps": 37500},
+        # The budget of the case at this level (caplab's score_run): over it for the passing run, which
+        # stays a pass (performance never enters the verdict); none for the others.
+        "performance": {"wall_time_s": 42.5, "mlups": 31.7, "steps": 37500, "threads": 2,
+                        **({"budget_s": 40.0, "verdict": "fail",
+                            "reason": "wall time 42.5 s over the budget of 40 s on 2 thread(s)"} if outcome == "pass"
+                           else {"budget_s": None, "verdict": "not judged",
+                                 "reason": "the case states no wall-time budget at level quick"})},
         "verdict": "pass" if sane and accuracy == "pass" else "fail",
     }
     write_json(out / "score.json", score)

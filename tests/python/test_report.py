@@ -106,6 +106,9 @@ def test_chapter_content(built):
     for study in ("Lai and Peskin (2000)", "Russel and Wang (2003)", "Xu and Wang (2006)", "Chew and Shu (2002)"):
         assert study in html
     assert "caplab (quick)" in html and "validation (external data)" in html and "thesis value (reproduction)" in html
+    # performance is its own verdict: the passing run is over its budget and still passes
+    assert "over the budget of 40 s on 2 thread(s)" in html and "budget 40.0 s" in html
+    assert "not judged (the case states no wall-time budget at level quick)" in html
     # the failed run shows caplab's message, the environment its build
     assert "expected a number &gt; 0" in html
     assert "0123456789ab" in html and "GNU 12.2.0" in html and "Test CPU" in html

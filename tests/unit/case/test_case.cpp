@@ -400,6 +400,20 @@ TEST(case_rejects, OutputTimesBeyondTheEnd) {
                       {"[0, 250)", "must not be empty"});
 }
 
+TEST(case_rejects, PerformanceBudgetForAnUndefinedLevelOrWithoutReason) {
+  json doc = cylinder_json();
+  doc["performance"] = {{"wall_time_budget_s", {{"standard", 600}}}, {"justification", "issue 2"}};
+  const auto spec = parse_case(doc, "edited.json", "quick", {});  // levels without a budget: not judged
+  ASSERT_TRUE(spec.performance);
+  EXPECT_EQ(spec.performance->wall_time_budget_s.at("standard"), 600);
+  doc["performance"]["wall_time_budget_s"]["standrd"] = 600;
+  expect_doc_rejected(doc, "/performance/wall_time_budget_s/standrd", {"did you mean \"standard\"?"});
+  doc["performance"]["wall_time_budget_s"] = {{"standard", 0}};
+  expect_doc_rejected(doc, "/performance/wall_time_budget_s/standard", {"0"});
+  doc["performance"] = {{"wall_time_budget_s", {{"standard", 600}}}};
+  expect_doc_rejected(doc, "/performance/justification", {});
+}
+
 TEST(case_rejects, ToleranceForAnUndefinedOrMissingLevel) {
   expect_set_rejected({"acceptance.0.tolerance.thesys=0.02"}, "/acceptance/0/tolerance/thesys",
                       {"did you mean \"thesis\"?"});

@@ -119,6 +119,37 @@ TEST_F(ScoreRun, PassingCase) {
   EXPECT_FALSE(fs::exists(dir_ / "score.json.tmp"));
 }
 
+// Performance is its own verdict: judged against the case's budget at the run's level, and
+// never part of the run's verdict or of --strict (timings depend on the machine).
+TEST_F(ScoreRun, PerformanceIsJudgedAgainstTheBudgetOfTheLevelAndNeverFailsTheRun) {
+  EXPECT_EQ(score()["performance"]["verdict"], "not judged");  // no budget in the case
+  manifest_["threads"] = 2;
+  case_["performance"] = {{"wall_time_budget_s", {{"quick", 20.0}, {"standard", 5.0}}},
+                          {"justification", "test budget"}};
+  json s = score();
+  EXPECT_EQ(s["performance"]["verdict"], "pass");
+  EXPECT_EQ(s["performance"]["budget_s"], 20.0);
+  EXPECT_EQ(s["performance"]["threads"], 2);
+  EXPECT_EQ(s["performance"]["justification"], "test budget");
+
+  manifest_["wall_time_s"] = 20.5;  // over the quick budget
+  s = score();
+  EXPECT_EQ(s["performance"]["verdict"], "fail");
+  EXPECT_NE(s["performance"]["reason"].get<std::string>().find("over the budget of 20 s on 2 thread(s)"),
+            std::string::npos);
+  EXPECT_EQ(s["verdict"], "pass");
+  EXPECT_EQ(exit_code(s, true), 0);
+  EXPECT_NE(format_scorecard(s).find("performance: fail"), std::string::npos);
+
+  manifest_["fidelity"] = "thesis";  // a level without a budget
+  EXPECT_EQ(score()["performance"]["verdict"], "not judged");
+  manifest_["fidelity"] = "quick";
+  manifest_["status"] = "diverged";  // a run that did not finish is not judged
+  s = score();
+  EXPECT_EQ(s["performance"]["verdict"], "not judged");
+  EXPECT_NE(s["performance"]["reason"].get<std::string>().find("did not finish"), std::string::npos);
+}
+
 TEST_F(ScoreRun, ValueOutsideToleranceFailsStrict) {
   manifest_["fidelity"] = "standard";  // 2 %: 1.46 is 1.5 % off, 1.48 is 2.9 % off
   summary_["metrics"]["drag_coefficient_mean"] = metric(1.48);
