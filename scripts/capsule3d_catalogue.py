@@ -24,7 +24,7 @@ def lattice_velocity(re, fine_per_a, tau_f):
 
 def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, fine, fine_per_a, subdivisions,
          end_time, average_from, walls=False, C=None, refinement="two_level", tau_f=3.5,
-         acceptance=(), quick_end=None, snapshots=(), quick_speedup=2):
+         acceptance=(), quick_end=None, snapshots=(), quick_speedup=2, performance=None):
     u = lattice_velocity(re, fine_per_a, tau_f)
     membrane = {"law": law, "capillary": G, "subdivisions": subdivisions}
     if C is not None:
@@ -79,6 +79,8 @@ def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, f
         },
         "acceptance": list(acceptance),
     }
+    if performance:  # a wall-time budget per level: score.json's performance verdict
+        doc["performance"] = performance
     if quick_end:
         doc["fidelity"]["quick"]["outputs.snapshots.times"] = [0, quick_end]
     # The fine block's faces lie on coarse nodes: at the quick level's coarser grid, widen the
