@@ -35,6 +35,7 @@ import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import matplotlib
 
@@ -42,9 +43,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib import ticker  # noqa: E402
 
+from .convergence import observed_order  # noqa: E402
 from .figures import png_data_uri  # noqa: E402
 from .references import ReferenceLibrary  # noqa: E402
-from .runs import catalogue_cases, finite  # noqa: E402
+from .runs import catalogue_cases  # noqa: E402
+
+if TYPE_CHECKING:
+    from .build import Page
 
 LEVELS = ("quick", "standard", "thesis")
 STAGES = ("fluid", "coupling", "ib", "membrane", "diagnostics", "output")
@@ -363,7 +368,7 @@ def load_series(path: Path, repo: Path | None = None, data: dict | None = None) 
                 if lv in levels:
                     raise _fail(path, f"{pat}/level", f"level already marks point {levels[lv]!r}", lv)
                 if p["fidelity"] != lv or p["set"].keys() - {"numerics.threads"}:
-                    raise _fail(path, f"{pat}/level", f"a catalogue level is the case run at that fidelity with no "
+                    raise _fail(path, f"{pat}/level", "a catalogue level is the case run at that fidelity with no "
                                 "overrides: give \"fidelity\": \"" + str(lv) + "\" and an empty \"set\"",
                                 {"level": lv, "fidelity": p["fidelity"], "set": p["set"]})
                 levels[lv] = label
@@ -454,7 +459,7 @@ def richardson(h: list[float], f: list[float], order="observed") -> dict:
     be done (fewer points than needed, oscillating or non-convergent values).
 
     ``order`` "observed": the three smallest h; p from (f1 - f2)/(f2 - f3) = (h1^p - h2^p)/(h2^p - h3^p)
-    (any ratios), by bisection over 0.05 <= p <= 8. A number: least squares over all points."""
+    (any ratios; convergence.observed_order). A number: least squares over all points."""
     pts = sorted((float(a), float(b)) for a, b in zip(h, f) if _num(a) and _num(b) and a > 0)
     if order != "observed":
         if len(pts) < 2:
@@ -477,24 +482,12 @@ def richardson(h: list[float], f: list[float], order="observed") -> dict:
     if d23 == 0 or d12 == 0 or (d12 > 0) != (d23 > 0):
         return {"value": None, "order": None,
                 "note": f"not monotone in h ({f1:.6g}, {f2:.6g}, {f3:.6g}): no asymptotic range, no extrapolation"}
-    target = d12 / d23
-
-    def g(p):
-        return (h1 ** p - h2 ** p) / (h2 ** p - h3 ** p) - target
-
-    lo, hi = 0.05, 8.0
-    if g(lo) * g(hi) > 0:
+    found = observed_order([h1, h2, h3], [f1, f2, f3])
+    if found is None:
         return {"value": None, "order": None,
-                "note": f"ratio of differences {target:.3g} gives no order in [{lo:g}, {hi:g}]"}
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if g(lo) * g(mid) <= 0:
-            hi = mid
-        else:
-            lo = mid
-    p = 0.5 * (lo + hi)
-    value = f3 - d23 * h3 ** p / (h2 ** p - h3 ** p)
-    return {"value": value, "order": p, "note": f"observed order {p:.2f} from the three finest points"}
+                "note": f"ratio of differences {d12 / d23:.3g} gives no order in (0.05, 20)"}
+    return {"value": found.extrapolated, "order": found.order,
+            "note": f"observed order {found.order:.2f} from the three finest points"}
 
 
 # ---- the error series: results per point --------------------------------------------------------------
@@ -729,13 +722,6 @@ def error_section(series_file: Path | None, results: Path | None, mode: str = "a
 
 # ---- the page -------------------------------------------------------------------------------------------
 
-@dataclass
-class Page:
-    html: Path
-    pdf: Path | None = None
-    problems: list[str] = field(default_factory=list)
-
-
 def fmt_pct(v, decimals: int = 1) -> str:
     """0.8123 -> "81.2 %" (fixed decimals, never an exponent)."""
     return f"{100 * float(v):.{decimals}f} %" if _num(v) else "–"
@@ -768,11 +754,10 @@ def build_page(bench_json: Path | None, out: Path, results: Path | None = None, 
     """Writes ``out/index.html`` (and the PDF) from bench.json, the results tree and the error series."""
     import datetime as _dt
 
-    from .build import git_sha, locked, print_pdf, write_atomically
+    from .build import git_sha, publish
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    page = Page(out / "index.html")
     bench, bench_problem = None, ""
     if bench_json is None or not Path(bench_json).is_file():
         bench_problem = f"{bench_json}: not found — run `caplab bench --out {out}` (make bench) first"
@@ -787,18 +772,8 @@ def build_page(bench_json: Path | None, out: Path, results: Path | None = None, 
     meta = {"generated": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
             "results": f"{bench_json}, {results}/{fidelity}, {error_results}", "report_git_sha": git_sha(),
             "fidelity": fidelity}
-    for p in (bench_problem, error.get("problem")):
-        if p:
-            page.problems.append(p)
-    with locked(out):
-        write_atomically(page.html, render(bench, stages, error, meta, bench_problem))
-        if pdf:
-            problem = print_pdf(page.html, out / "index.pdf", chromium)
-            if problem:
-                page.problems.append(problem)
-            else:
-                page.pdf = out / "index.pdf"
-    return page
+    return publish(out, render(bench, stages, error, meta, bench_problem), pdf, chromium,
+                   [p for p in (bench_problem, error.get("problem")) if p])
 
 
 def main(argv=None) -> int:

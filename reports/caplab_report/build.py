@@ -267,6 +267,28 @@ def print_pdf(html: Path, pdf: Path, chromium: str = "chromium", timeout: float 
         shutil.rmtree(profile, ignore_errors=True)
 
 
+@dataclass
+class Page:
+    """A standalone page (stress, bench): its HTML, its PDF when printed, what went wrong."""
+    html: Path
+    pdf: Path | None = None
+    problems: list[str] = field(default_factory=list)
+
+
+def publish(out: Path, text: str, pdf: bool, chromium: str, problems: list[str] | None = None) -> Page:
+    """Writes OUT/index.html atomically under the folder's lock and, when ``pdf``, prints index.pdf."""
+    page = Page(out / "index.html", problems=list(problems or []))
+    with locked(out):
+        write_atomically(page.html, text)
+        if pdf:
+            problem = print_pdf(page.html, out / "index.pdf", chromium)
+            if problem:
+                page.problems.append(problem)
+            else:
+                page.pdf = out / "index.pdf"
+    return page
+
+
 def git_sha() -> str:
     try:
         out = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short=12", "HEAD"], capture_output=True,

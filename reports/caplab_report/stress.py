@@ -34,8 +34,8 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import matplotlib
 
@@ -45,6 +45,9 @@ import numpy as np  # noqa: E402
 
 from . import figures, stress_theory  # noqa: E402
 from .runs import finite  # noqa: E402
+
+if TYPE_CHECKING:
+    from .build import Page
 
 CLASSES = ("stable", "inaccurate", "unstable", "failed", "input_error")
 CLASS_LABELS = {"stable": "stable", "inaccurate": "stable but inaccurate", "unstable": "unstable",
@@ -758,13 +761,6 @@ def divergence_figure(point: dict) -> str | None:
 
 # ---- the page ---------------------------------------------------------------------------------------
 
-@dataclass
-class Page:
-    html: Path
-    pdf: Path | None = None
-    problems: list[str] = field(default_factory=list)
-
-
 def example_divergences(sweep: dict, n: int = 3) -> list[dict]:
     """A few unstable points with their messages: the earliest, the latest and one in between
     (by the step at which caplab stopped), plus every guard miss."""
@@ -884,17 +880,8 @@ def tension_table() -> list[dict]:
 
 
 def build_page(stress_json: Path, out: Path, pdf: bool = True, chromium: str = "chromium") -> Page:
-    from .build import locked, print_pdf, write_atomically
+    from .build import publish
 
     data = json.loads(Path(stress_json).read_text(encoding="utf-8"))
     out.mkdir(parents=True, exist_ok=True)
-    page = Page(out / "index.html")
-    with locked(out):
-        write_atomically(page.html, render(data, out))
-        if pdf:
-            problem = print_pdf(page.html, out / "index.pdf", chromium)
-            if problem:
-                page.problems.append(problem)
-            else:
-                page.pdf = out / "index.pdf"
-    return page
+    return publish(out, render(data, out), pdf, chromium)
