@@ -398,26 +398,25 @@ json accuracy(const std::string& status, const JsonFile& case_file, const JsonFi
   return result;
 }
 
-}  // namespace
-
 /// The performance verdict: the manifest's wall time against the case's budget at the run's level.
 json performance(const std::string& status, const json* manifest, const json* case_doc, const std::string& fidelity) {
+  const auto member = [](const json* object, const char* key) {
+    return object && object->is_object() && object->contains(key) ? (*object)[key] : json(nullptr);
+  };
   json perf = json::object();
-  for (const char* key : {"wall_time_s", "mlups", "steps", "threads"})
-    perf[key] = manifest && manifest->contains(key) ? (*manifest)[key] : json(nullptr);
-  const json* spec = case_doc && case_doc->contains("performance") ? &(*case_doc)["performance"] : nullptr;
-  const json* budgets = spec && spec->is_object() && spec->contains("wall_time_budget_s")
-                            ? &(*spec)["wall_time_budget_s"] : nullptr;
-  const json budget = budgets && budgets->is_object() ? budgets->value(fidelity, json(nullptr)) : json(nullptr);
+  for (const char* key : {"wall_time_s", "mlups", "steps", "threads"}) perf[key] = member(manifest, key);
+  const json spec = member(case_doc, "performance");
+  const json budgets = member(&spec, "wall_time_budget_s");
+  const json budget = member(&budgets, fidelity.c_str());
   perf["budget_s"] = budget.is_number() ? budget : json(nullptr);
-  if (spec && spec->is_object() && (*spec).contains("justification")) perf["justification"] = (*spec)["justification"];
+  if (spec.contains("justification")) perf["justification"] = spec["justification"];
   const json& wall = perf["wall_time_s"];
   if (!budget.is_number()) {
     perf["verdict"] = "not judged";
     perf["reason"] = fmt::format("the case states no wall-time budget at level {}", fidelity.empty() ? "?" : fidelity);
   } else if (status != "ok" || !wall.is_number()) {
     perf["verdict"] = "not judged";
-    perf["reason"] = "the run did not finish (" + status + ")";
+    perf["reason"] = status != "ok" ? "the run did not finish (" + status + ")" : "manifest.json has no wall_time_s";
   } else {
     const double w = wall.get<double>(), b = budget.get<double>();
     perf["verdict"] = w <= b ? "pass" : "fail";
@@ -427,6 +426,8 @@ json performance(const std::string& status, const json* manifest, const json* ca
   }
   return perf;
 }
+
+}  // namespace
 
 json evaluate_run(const fs::path& run_dir, const ScoreOptions& options) {
   if (!io::RunDirectory::is_run_directory(run_dir))
