@@ -41,7 +41,6 @@ const std::map<std::string, double> kModeOrder{
     {"steady_tank_treading", 0}, {"oscillating_tank_treading", 1}, {"tumbling", 2}};
 const std::vector<std::string> kTankTreading{"steady_tank_treading", "oscillating_tank_treading"};
 
-bool finite(const json& v) { return v.is_number() && std::isfinite(v.get<double>()); }
 
 /// `object[key]` as a double when it is a finite number, else `fallback`.
 json number_or(const json& object, const char* key, json fallback) {
@@ -49,10 +48,6 @@ json number_or(const json& object, const char* key, json fallback) {
                                                                            : fallback;
 }
 
-const json& member(const json& object, const char* key) {
-  static const json null;
-  return object.is_object() && object.contains(key) ? object[key] : null;
-}
 
 /// `v` when it is an array, else an empty array (for loops over optional fields).
 const json& array_or_empty(const json& v) {
@@ -240,11 +235,6 @@ std::vector<std::string> mismatches(const json& claim, const json& params) {
   return wrong;
 }
 
-std::string join(const std::vector<std::string>& parts, const char* separator) {
-  std::string out;
-  for (const auto& p : parts) out += (out.empty() ? "" : separator) + p;
-  return out;
-}
 
 /// The acceptance entry of the run's case that names the claim ("...json#<id>"), or null.
 const json* naming_entry(const Run& run, const std::string& id) {

@@ -17,6 +17,7 @@
 #include "core/error.hpp"
 #include "io/series_writer.hpp"
 #include "score/comparators.hpp"
+#include "score/run_files.hpp"
 
 namespace caplab::score {
 
@@ -32,22 +33,12 @@ struct Malformed : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-bool finite(const json& v) { return v.is_number() && std::isfinite(v.get<double>()); }
 
-const json& member(const json& object, const char* key) {
-  static const json null;
-  return object.is_object() && object.contains(key) ? object[key] : null;
-}
 
 std::string text_or(const json& v, const std::string& fallback) {
   return v.is_string() ? v.get<std::string>() : fallback;
 }
 
-std::string join(const std::vector<std::string>& parts, const char* separator) {
-  std::string out;
-  for (const auto& p : parts) out += (out.empty() ? "" : separator) + p;
-  return out;
-}
 
 /// "12.34 %" of a fraction; "–" when it is not finite.
 std::string pct(double x) { return std::isfinite(x) ? fmt::format("{:.2f} %", 100 * x) : "–"; }

@@ -1,5 +1,6 @@
 #include "score/run_files.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <system_error>
 
@@ -20,6 +21,19 @@ JsonFile read_json(const fs::path& file) {
 
 const json& metric_json(const json& metric) {
   return metric.is_object() && metric.contains("value") ? metric["value"] : metric;
+}
+
+const nlohmann::json& member(const nlohmann::json& object, const char* key) {
+  static const nlohmann::json null;
+  return object.is_object() && object.contains(key) ? object[key] : null;
+}
+
+bool finite(const nlohmann::json& v) { return v.is_number() && std::isfinite(v.get<double>()); }
+
+std::string join(const std::vector<std::string>& parts, const char* separator) {
+  std::string out;
+  for (const auto& p : parts) out += (out.empty() ? "" : separator) + p;
+  return out;
 }
 
 }  // namespace caplab::score

@@ -400,14 +400,12 @@ json accuracy(const std::string& status, const JsonFile& case_file, const JsonFi
 
 /// The performance verdict: the manifest's wall time against the case's budget at the run's level.
 json performance(const std::string& status, const json* manifest, const json* case_doc, const std::string& fidelity) {
-  const auto member = [](const json* object, const char* key) {
-    return object && object->is_object() && object->contains(key) ? (*object)[key] : json(nullptr);
-  };
+  static const json none;
+  const json& m = manifest ? *manifest : none;
   json perf = json::object();
-  for (const char* key : {"wall_time_s", "mlups", "steps", "threads"}) perf[key] = member(manifest, key);
-  const json spec = member(case_doc, "performance");
-  const json budgets = member(&spec, "wall_time_budget_s");
-  const json budget = member(&budgets, fidelity.c_str());
+  for (const char* key : {"wall_time_s", "mlups", "steps", "threads"}) perf[key] = member(m, key);
+  const json& spec = member(case_doc ? *case_doc : none, "performance");
+  const json& budget = member(member(spec, "wall_time_budget_s"), fidelity.c_str());
   perf["budget_s"] = budget.is_number() ? budget : json(nullptr);
   if (spec.contains("justification")) perf["justification"] = spec["justification"];
   const json& wall = perf["wall_time_s"];
