@@ -436,11 +436,11 @@ def _jeffery_rows(family: Family, r: float) -> list[dict]:
 
 @dataclass
 class Series:
-    """Runs of one capsule case that differ only in the grid (or only in the domain)."""
+    """Runs of one capsule case that differ only in the grid, the domain or the membrane nodes."""
 
-    what: str              #: "grid" | "domain"
+    what: str              #: "grid" | "domain" | "nodes"
     title: str
-    runs: list[Run]        #: coarsest (or smallest) first; the last is the self-reference
+    runs: list[Run]        #: coarsest (smallest, fewest nodes) first; the last is the self-reference
     rows: list[dict] = field(default_factory=list)
     figure: str | None = None
 
@@ -448,6 +448,17 @@ class Series:
 def _domain(run: Run) -> tuple:
     size = (run.physics.get("domain") or {}).get("size")
     return tuple(size) if isinstance(size, list) else ()
+
+
+def _nodes(run: Run) -> int | None:
+    n = ((capsule_body(run) or {}).get("membrane") or {}).get("nodes")
+    return int(n) if finite(n) else None
+
+
+def _marker_ratio(run: Run) -> float:
+    """Marker spacing of the round capsule over the fine spacing (0 when unknown)."""
+    n, h = _nodes(run), run.fine_spacing
+    return 2 * math.pi / n / h if n and h else 0.0
 
 
 def _rms_to_reference(run: Run, ref: Run, name: str, cache: dict):
@@ -462,20 +473,40 @@ def _rms_to_reference(run: Run, ref: Run, name: str, cache: dict):
     return float(np.sqrt(np.nanmean(diff ** 2))), float(np.nanmax(np.abs(diff)))
 
 
+def _one_per_spacing(members: list[Run]) -> list[Run]:
+    """A grid study refines the grid (and the membrane with it, thesis fig. 4.3, or not, fig.
+    2.18); a run that differs from another at its spacing only in the node count belongs to a
+    node study: keep, per spacing, the run whose marker-to-grid ratio is nearest the study's median."""
+    ratios = sorted(_marker_ratio(r) for r in members)
+    median = ratios[len(ratios) // 2]
+    best: dict[float, Run] = {}
+    for run in members:
+        other = best.get(run.fine_spacing)
+        if other is None or abs(_marker_ratio(run) - median) < abs(_marker_ratio(other) - median):
+            best[run.fine_spacing] = run
+    return [r for r in members if best.get(r.fine_spacing) is r]
+
+
+_STUDY = {  # what: (key fixed beyond the capsule's parameters, the measure that varies)
+    "grid": (lambda r: _domain(r), lambda r: -r.fine_spacing),
+    "domain": (lambda r: (r.fine_spacing, _nodes(r)), lambda r: _domain(r)[0] if _domain(r) else 0),
+    "nodes": (lambda r: (r.fine_spacing,) + _domain(r), lambda r: _nodes(r) or 0),
+}
+
+
 def series_groups(runs: list[Run], cache: dict) -> list[Series]:
     out = []
-    for what in ("grid", "domain"):
+    for what, (fixed_of, measure) in _STUDY.items():
         groups: dict[tuple, list[Run]] = {}
         for run in runs:
             if run.status != "ok" or run.fine_spacing is None:
                 continue
             p = parameters(run)
-            fixed = _domain(run) if what == "grid" else (run.fine_spacing,)
-            groups.setdefault(tuple(p.get(k) for k in KEYS) + fixed, []).append(run)
+            groups.setdefault(tuple(p.get(k) for k in KEYS) + tuple(fixed_of(run)), []).append(run)
         for members in groups.values():
-            measure = (lambda r: -r.fine_spacing) if what == "grid" else (lambda r: _domain(r)[0] if _domain(r) else 0)
-            distinct = {measure(r) for r in members}
-            if len(distinct) < 2:
+            if what == "grid":
+                members = _one_per_spacing(members)
+            if len({measure(r) for r in members}) < 2:
                 continue
             members = sorted(members, key=lambda r: (measure(r), r.fidelity))
             ref = members[-1]
@@ -490,6 +521,7 @@ def series_groups(runs: list[Run], cache: dict) -> list[Series]:
                 errors.append((run.fine_spacing, d[0] if d else None))
                 group.rows.append({"run": run.case_id, "fidelity": run.fidelity, "anchor": run.anchor,
                                    "spacing": f"{run.fine_spacing:g}", "domain": " × ".join(f"{x:g}" for x in _domain(run)),
+                                   "nodes": _nodes(run) or "–",
                                    "d_rms": f"{d[0]:.3g}" if d else "–", "d_max": f"{d[1]:.3g}" if d else "–",
                                    "theta_rms": f"{th[0]:.3g}" if th else "–", "order": ""})
             if what == "grid":
@@ -508,7 +540,8 @@ def _series_figure(group: Series, cache: dict) -> str | None:
     for i, run in enumerate(group.runs):
         data = capsule_series(run, cache)
         last = i == len(group.runs) - 1
-        tag = (f"Δx_f = {run.fine_spacing:g}" if group.what == "grid"
+        tag = (f"Δx_f = {run.fine_spacing:g}, {_nodes(run)} nodes" if group.what == "grid"
+               else f"{_nodes(run)} nodes" if group.what == "nodes"
                else "domain " + " × ".join(f"{x:g}" for x in _domain(run)))
         tag += " (self-reference)" if last else ""
         for ax, name, scale in ((axes[0], "taylor_deformation", 1.0), (axes[1], "inclination", math.pi)):
@@ -525,7 +558,8 @@ def _series_figure(group: Series, cache: dict) -> str | None:
         ax.set_xlabel("k t")
         ax.grid(True, lw=0.3, alpha=0.6)
         ax.legend(fontsize=7)
-    fig.suptitle(f"verification ({'self-convergence' if group.what == 'grid' else 'domain size'}): {group.title}",
+    study = {"grid": "self-convergence", "domain": "domain size", "nodes": "membrane nodes"}[group.what]
+    fig.suptitle(f"verification ({study}): {group.title}",
                  fontsize=8)
     fig.tight_layout()
     return figures.png_data_uri(fig)

@@ -1,8 +1,10 @@
 #include "diagnostics/shape2d.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <string>
 
 #include "core/error.hpp"
 
@@ -73,6 +75,16 @@ double polygon_perimeter(std::span<const Vec<2>> X) {
   const std::size_t n = X.size();
   for (std::size_t i = 0; i < n; ++i) p += (X[(i + 1) % n] - X[i]).norm();
   return p;
+}
+
+double max_length_change(std::span<const Vec<2>> X, std::span<const double> rest_lengths) {
+  CAPLAB_CHECK(rest_lengths.size() == X.size(), "max length change: " + std::to_string(rest_lengths.size()) +
+                                                    " rest lengths for " + std::to_string(X.size()) + " nodes");
+  double worst = 0.0;
+  const std::size_t n = X.size();
+  for (std::size_t i = 0; i < n; ++i)
+    worst = std::max(worst, std::abs((X[(i + 1) % n] - X[i]).norm() / rest_lengths[i] - 1.0));
+  return worst;
 }
 
 Vec<2> polygon_centroid(std::span<const Vec<2>> X) {

@@ -39,6 +39,11 @@ struct EquivalentEllipse {
 /// Perimeter of the closed polygon X (including the edge from the last node to the first).
 double polygon_perimeter(std::span<const Vec<2>> X);
 
+/// Largest local stretch of the closed polygon X against its rest edge lengths:
+/// max over edges i -> i+1 (the last joins the first) of |l_i / rest_i - 1| (the 2D membrane's
+/// "area change", thesis 3.2.3: its length changes locally). Throws core::Error when the sizes differ.
+double max_length_change(std::span<const Vec<2>> X, std::span<const double> rest_lengths);
+
 /// Centroid of the area enclosed by X. Throws core::Error when the signed area is not positive.
 Vec<2> polygon_centroid(std::span<const Vec<2>> X);
 

@@ -2,7 +2,8 @@
 // dimension, with their units and definitions, and the mesh it adds to a snapshot.
 //
 // 2D (thesis ch. 2-4): the equivalent ellipse of the enclosed area (diagnostics/shape2d.hpp):
-// D_xy and inclination, the enclosed-area change, a tracked node's phase and the tank-treading
+// D_xy and inclination, the enclosed-area change, the membrane's length change (total and the
+// largest local stretch), a tracked node's phase and the tank-treading
 // period from the tangential membrane velocity.
 // 3D (thesis ch. 5-6): the equivalent ellipsoid of the enclosed volume (diagnostics/shape3d.hpp)
 // in the shear plane x-z of u = (k z, 0, 0): D_xz, inclination, the semi-axes (length and
@@ -30,6 +31,7 @@
 #include "geometry/triangle_mesh.hpp"
 #include "io/snapshot_writer.hpp"
 #include "membrane/fem_membrane.hpp"
+#include "membrane/ring_membrane.hpp"
 #include "sim/capsule.hpp"
 
 namespace caplab::sim {
@@ -59,7 +61,7 @@ struct TrackAngles {
 template <>
 class CapsuleTrack<2> {
  public:
-  static constexpr std::array<CapsuleQuantity, 5> quantities{{
+  static constexpr std::array<CapsuleQuantity, 7> quantities{{
       {"taylor_deformation", "1",
        "D_xy = (L - B)/(L + B), L, B semi-axes of the ellipse with the inertia tensor of the enclosed area "
        "(thesis eq. 2.33)"},
@@ -67,6 +69,9 @@ class CapsuleTrack<2> {
        "angle of the major axis of that ellipse from the x axis, continuous in time (tumbling keeps "
        "decreasing); counter-clockwise positive"},
       {"area_change", "1", "enclosed area over its initial value, minus 1"},
+      {"length_change", "1", "membrane contour length over its initial value, minus 1"},
+      {"max_length_change", "1",
+       "largest |l_i/l_i0 - 1| over the membrane's segments, l_i0 the rest length (local stretch)"},
       {"tank_treading_phase", "rad",
        "angle of membrane node 0 about the centroid, continuous in time (tank-treading: decreasing)"},
       {"tank_treading_period", "1/k",
@@ -74,7 +79,11 @@ class CapsuleTrack<2> {
        "around the current contour (exact for a steady tank-treading shape)"},
   }};
 
-  explicit CapsuleTrack(const Capsule<2>& c) : area0_(diagnostics::equivalent_ellipse(c.positions()).area) {
+  /// `ring`: the capsule's membrane, whose rest lengths the local stretch is measured against.
+  CapsuleTrack(const Capsule<2>& c, const membrane::RingMembrane& ring)
+      : ring_(&ring),
+        area0_(diagnostics::equivalent_ellipse(c.positions()).area),
+        length0_(diagnostics::polygon_perimeter(c.positions())) {
     update(c);
   }
 
@@ -93,6 +102,8 @@ class CapsuleTrack<2> {
     if (q == "taylor_deformation") return shape_.taylor;
     if (q == "inclination") return theta_;
     if (q == "area_change") return volume_change();
+    if (q == "length_change") return diagnostics::polygon_perimeter(c.positions()) / length0_ - 1.0;
+    if (q == "max_length_change") return diagnostics::max_length_change(c.positions(), ring_->rest_lengths());
     if (q == "tank_treading_period") return tank_treading_period(c, velocity_lu);
     return phi_;
   }
@@ -126,7 +137,8 @@ class CapsuleTrack<2> {
     return period;
   }
 
-  double area0_;
+  const membrane::RingMembrane* ring_;
+  double area0_, length0_;
   diagnostics::EquivalentEllipse shape_;
   TrackAngles angles_;
   double theta_ = 0.0, phi_ = 0.0;

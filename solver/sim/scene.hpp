@@ -381,8 +381,9 @@ class Scene {
       else if (m.reference_curvature == cases::MembraneSpec::ReferenceCurvature::flat)
         kappa0 = membrane::ReferenceCurvature::flat;
       auto ring = std::make_unique<membrane::RingMembrane>(rest, E, E_B, kappa0);
+      const auto& ring_ref = *ring;
       capsules_.emplace_back(b.name, std::move(rest), std::move(ring), make_transfer());
-      capsule_tracks_.emplace_back(capsules_.back());
+      capsule_tracks_.emplace_back(capsules_.back(), ring_ref);
     } else {
       // Node forces of a surface modulus scale with length (f ~ E A0 / l): with positions in L
       // the modulus E / h gives forces in lattice units (h = fine spacing in L).
@@ -952,7 +953,8 @@ class Scene {
       metrics[prefix + q + "_mean"] = {{"value", s.mean}, {"unit", unit}, {"definition", "time average" + window}};
       metrics[prefix + q + "_amplitude"] = {{"value", s.amplitude}, {"unit", unit}, {"definition", "(max - min)/2" + window}};
     }
-    for (const char* q : {"area_change", "volume_change", "surface_area_change", "max_area_change"}) {
+    for (const char* q : {"area_change", "volume_change", "surface_area_change", "max_area_change", "length_change",
+                          "max_length_change"}) {
       const auto* v = column(q);
       if (!v) continue;
       double worst = 0;

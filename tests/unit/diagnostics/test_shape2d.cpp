@@ -69,6 +69,17 @@ TEST(Shape2d, MomentsAboutTheCentroidNotTheVertexMean) {
   EXPECT_NEAR(polygon_perimeter(tri), b + h + std::hypot(b, h), 1e-14);
 }
 
+TEST(Shape2d, MaxLengthChangeIsTheLargestSegmentStretch) {
+  // Square of side 2 against rest lengths 2: the edge from node 1 to node 2 stretched by 10 %,
+  // the closing edge (node 3 to node 0) against a rest length 2.5 is 20 % short.
+  const std::vector<Vec<2>> square = {{0, 0}, {2, 0}, {2.0, 2.2}, {0, 2}};
+  const std::vector<double> rest = {2.0, 2.0, std::hypot(2.0, 0.2), 2.5};
+  EXPECT_NEAR(max_length_change(square, rest), 0.2, 1e-15);
+  const std::vector<double> exact = {2.0, 2.2, std::hypot(2.0, 0.2), 2.0};
+  EXPECT_NEAR(max_length_change(square, exact), 0.0, 1e-15);
+  EXPECT_THROW(max_length_change(square, std::vector<double>(3, 2.0)), core::Error);
+}
+
 TEST(Shape2d, CircleHasNoDeformation) {
   const int n = 160;
   const auto X = geometry::ring_nodes({geometry::RingShape::Type::circle}, Vec<2>(5, 7), 2.0, 0.3, n);
