@@ -47,6 +47,16 @@ class CapsuleTrack;
 /// Below this Taylor parameter an initially round capsule has no axis worth following.
 inline constexpr double round_capsule_taylor = 1e-4;
 
+/// The continuous inclination of a capsule's axis, the angle in (-pi/2, pi/2] as measured. An
+/// initially round capsule starts at D = 0, where the axis is noise: while it is that round the
+/// history is forgotten and the raw angle reported, so the first meaningful axis starts it (a
+/// round first reading fed to the unwrapper put a later 45 degrees on the branch 45 - 180).
+inline double follow_axis(diagnostics::AngleUnwrapper& unwrap, double taylor, double angle) {
+  if (taylor >= round_capsule_taylor) return unwrap(angle);
+  unwrap.reset();
+  return angle;
+}
+
 /// The inclination and the tracked node's phase, kept continuous in time; their history is the
 /// only state of a track that a restart must restore (the shape is recomputed every step).
 struct TrackAngles {
@@ -90,9 +100,7 @@ class CapsuleTrack<2> {
   void update(const Capsule<2>& c) {
     const auto X = c.positions();
     shape_ = diagnostics::equivalent_ellipse(X);
-    // An initially circular capsule starts at D = 0: follow its axis only once there is one.
-    if (shape_.taylor < round_capsule_taylor) angles_.inclination.reset();
-    theta_ = angles_.inclination(shape_.inclination);
+    theta_ = follow_axis(angles_.inclination, shape_.taylor, shape_.inclination);
     const Vec<2> r = X[0] - shape_.centroid;
     phi_ = angles_.phase(std::atan2(r[1], r[0]));
   }
@@ -178,8 +186,7 @@ class CapsuleTrack<3> {
   void update(const Capsule<3>& c) {
     const auto X = c.positions();
     shape_ = diagnostics::equivalent_ellipsoid(X, fem_->triangles());
-    if (shape_.taylor_xz < round_capsule_taylor) angles_.inclination.reset();
-    theta_ = angles_.inclination(shape_.inclination);
+    theta_ = follow_axis(angles_.inclination, shape_.taylor_xz, shape_.inclination);
     const Vec<3> r = X[tracked_] - shape_.center;
     phi_ = angles_.phase(std::atan2(r[2], r[0]));
   }

@@ -354,7 +354,7 @@ def test_quantitative_statements():
     assert c["ch3.biconcave.Eb0.01.transition"]["between"] == [0.01, 0.02]
     assert c["ch3.area_change"]["upper"] == 0.001 and c["ch3.area_change"]["metric"] == "area_change_max"
     length = c["ch3.biconcave.G0.0025.membrane_length_change"]
-    assert length["upper"] == 0.005 and length["metric"] == "max_length_change_max"  # the membrane, not the enclosed area
+    assert length["upper"] == 0.005 and length["metric"] == "length_change_max"  # the membrane, not the enclosed area
     assert c["ch3.circle.tt_frequency"]["limit"] == 1.0
     assert c["ch3.ellipse.G0.04.Eb0.4.jeffery"]["value"] == pytest.approx(math.pi * 5 / 2)
     assert c["ch4.tt_frequency_vs_Re"]["direction"] == "decreasing"
