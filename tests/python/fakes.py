@@ -145,7 +145,7 @@ def make_run_dir(out: Path, case: dict, fidelity: str = "quick", outcome: str = 
 def capsule_case(case_id: str, shape: str = "ellipse", capillary: float = 0.04, bending_ratio: float = 0.0,
                  reference_curvature: str = "initial", reynolds: float = 0.05, claim: str | None = None,
                  reference_mode=None, fine_spacing: float = 0.05, domain: float = 16.0, end_time: float = 30.0,
-                 title: str | None = None) -> dict:
+                 title: str | None = None, nodes: int = 160) -> dict:
     """A 2D capsule case in the catalogue format (a body with a "membrane"); with ``claim`` one mode
     acceptance entry naming references/capsule2d/claims.json#<claim>."""
     shape_spec = {"type": shape, "center": [domain / 2, domain / 2], "diameter": 2.0, "angle": 0.0}
@@ -161,7 +161,7 @@ def capsule_case(case_id: str, shape: str = "ellipse", capillary: float = 0.04, 
                     "domain": {"size": [domain, domain], "boundaries": ["periodic", "wall"]},
                     "bodies": [{"name": "capsule", "shape": shape_spec,
                                 "membrane": {"law": "hooke", "capillary": capillary, "bending_ratio": bending_ratio,
-                                             "reference_curvature": reference_curvature, "nodes": 160}}]},
+                                             "reference_curvature": reference_curvature, "nodes": nodes}}]},
         "numerics": {"grid": {"refinement": "uniform", "fine_spacing": fine_spacing}, "end_time": end_time},
         "outputs": {"series": {"interval": 0.05, "quantities": ["taylor_deformation", "inclination", "area_change",
                                                                  "tank_treading_phase"]},

@@ -66,6 +66,10 @@ def capsule_runs():
                   reference_mode="steady_tank_treading"), "steady_tank_treading"))
     ch4 = [(C(f"ch4/circle_G0.04_Re{re}", shape="circle", capillary=0.04, reynolds=re, claim="ch4.mode",
               reference_mode="steady_tank_treading"), "steady_tank_treading") for re in (1, 10, 100)]
+    # thesis fig. 4.3: the grid refined with the membrane (120 nodes on 2a = 30 spacings), and 240
+    # instead of 160 nodes on the same grid
+    ch4 += [(C(f"ch4/circle_G0.04_Re100_{tag}", shape="circle", capillary=0.04, reynolds=100, fine_spacing=h,
+               nodes=n), "steady_tank_treading") for tag, h, n in (("grid30", 2 / 30, 120), ("nodes240", 0.05, 240))]
     return ell + ch2 + ch4
 
 
@@ -171,6 +175,19 @@ def test_not_available_reference_and_self_convergence(built):
     assert "ch2/capsule_circle_G0.0125_grid60, quick" in section  # the finest grid is the reference
     orders = [float(x) for x in re.findall(r'<td class="num">(\d+\.\d\d)</td></tr>', section)]
     assert orders and all(1.0 < p < 4.0 for p in orders), orders  # fakes: error ~ h^2
+
+
+def test_a_node_study_is_not_mistaken_for_a_grid_study(built):
+    ch4 = built["html"][4]
+    section = ch4[ch4.index('id="capsule-verification"'):ch4.index('id="cases"')]
+    grid = section[section.index("<b>Self-convergence</b>"):]
+    grid = grid[:grid.index("</table>")]
+    assert "ch4/circle_G0.04_Re100_grid30" in grid and "ch4/circle_G0.04_Re100_nodes240" not in grid
+    assert "(ch4/circle_G0.04_Re100, quick) is the self-reference" in grid  # 160 nodes on 0.05a, the finest
+    nodes = section[section.index("<b>Membrane nodes</b>"):]
+    nodes = nodes[:nodes.index("</table>")]
+    assert "(ch4/circle_G0.04_Re100_nodes240, quick) is the self-reference" in nodes
+    assert "ch4/circle_G0.04_Re100</a>" in nodes and "grid30" not in nodes
 
 
 def test_references_page_lists_claims_and_analytic(built):
