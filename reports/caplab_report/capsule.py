@@ -455,10 +455,11 @@ def _nodes(run: Run) -> int | None:
     return int(n) if finite(n) else None
 
 
-def _marker_ratio(run: Run) -> float:
-    """Marker spacing of the round capsule over the fine spacing (0 when unknown)."""
+def _grid_per_marker(run: Run) -> float:
+    """Nodes times fine spacing: within one capsule shape, proportional to the grid spacing over
+    the marker spacing (0 when unknown)."""
     n, h = _nodes(run), run.fine_spacing
-    return 2 * math.pi / n / h if n and h else 0.0
+    return n * h if n and h else 0.0
 
 
 def _rms_to_reference(run: Run, ref: Run, name: str, cache: dict):
@@ -477,12 +478,12 @@ def _one_per_spacing(members: list[Run]) -> list[Run]:
     """A grid study refines the grid (and the membrane with it, thesis fig. 4.3, or not, fig.
     2.18); a run that differs from another at its spacing only in the node count belongs to a
     node study: keep, per spacing, the run whose marker-to-grid ratio is nearest the study's median."""
-    ratios = sorted(_marker_ratio(r) for r in members)
+    ratios = sorted(_grid_per_marker(r) for r in members)
     median = ratios[len(ratios) // 2]
     best: dict[float, Run] = {}
     for run in members:
         other = best.get(run.fine_spacing)
-        if other is None or abs(_marker_ratio(run) - median) < abs(_marker_ratio(other) - median):
+        if other is None or abs(_grid_per_marker(run) - median) < abs(_grid_per_marker(other) - median):
             best[run.fine_spacing] = run
     return [r for r in members if best.get(r.fine_spacing) is r]
 

@@ -20,6 +20,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <span>
 #include <string>
 #include <string_view>
@@ -79,7 +80,7 @@ class CapsuleTrack<2> {
        "angle of the major axis of that ellipse from the x axis, continuous in time (tumbling keeps "
        "decreasing); counter-clockwise positive"},
       {"area_change", "1", "enclosed area over its initial value, minus 1"},
-      {"length_change", "1", "membrane contour length over its initial value, minus 1"},
+      {"length_change", "1", "membrane contour length over its rest length (the initial one), minus 1"},
       {"max_length_change", "1",
        "largest |l_i/l_i0 - 1| over the membrane's segments, l_i0 the rest length (local stretch)"},
       {"tank_treading_phase", "rad",
@@ -93,7 +94,7 @@ class CapsuleTrack<2> {
   CapsuleTrack(const Capsule<2>& c, const membrane::RingMembrane& ring)
       : ring_(&ring),
         area0_(diagnostics::equivalent_ellipse(c.positions()).area),
-        length0_(diagnostics::polygon_perimeter(c.positions())) {
+        length0_(std::accumulate(ring.rest_lengths().begin(), ring.rest_lengths().end(), 0.0)) {
     update(c);
   }
 
