@@ -39,7 +39,8 @@ def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, f
         "description": description + (
             f" Lattice: fine spacing a/{fine_per_a}, k a = {u:g} in lattice units (tau_f = {tau_f}, TRT), "
             f"{4 ** subdivisions * 8} triangles, single-precision populations (measured on the NH sphere at G = 0.05: "
-            "the same steady D as double precision to 1e-6, 13 % less run time at quick; level thesis: double). Quick: half the resolution (a/{fine_per_a // 2}, "
+            "the same steady D as double precision to 1e-6, 13 % less run time at quick; level thesis: double). "
+            f"Quick: half the resolution (a/{fine_per_a // 2}, "
             f"{4 ** (subdivisions - 1) * 8} triangles) and "
             + ("twice the lattice velocity (same tau_f)." if quick_speedup == 2 else
                "the same lattice velocity (the walls' Mach number stays below 0.25; tau_f closer to 1/2)."

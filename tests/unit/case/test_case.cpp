@@ -168,6 +168,20 @@ TEST(case_catalogue, EveryCaseLoadsAtEveryLevel) {
   }
 }
 
+// The chapter 5 and 6 cases are written by Python generators (scripts/generate-ch*-cases): a
+// string that lost its f prefix leaves "{name}" in the text a user reads.
+TEST(case_catalogue, TitlesAndDescriptionsHaveNoUnfilledPlaceholders) {
+  for (const auto& entry : fs::recursive_directory_iterator(source_dir / "catalogue")) {
+    if (entry.path().extension() != ".json" || entry.path().filename() == "schema.json") continue;
+    std::ifstream in(entry.path());
+    const json doc = json::parse(in);
+    for (const char* key : {"title", "description"}) {
+      const std::string text = doc.value(key, std::string());
+      EXPECT_EQ(text.find_first_of("{}"), std::string::npos) << entry.path() << " " << key << ": " << text;
+    }
+  }
+}
+
 // ---------------------------------------------------------------- overrides and resolved JSON
 
 TEST(case_overrides, SetNumberStringAndArrayEntry) {
