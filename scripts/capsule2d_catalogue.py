@@ -37,12 +37,12 @@ THESIS_LEVEL = {"numerics.lattice_velocity": THESIS_U, "numerics.collision.opera
 #: sentence on the quick level follows it (QUICK_HALF unless a case says otherwise).
 SETUP = ("Liquid-filled 2D capsule with a Hookean membrane (thesis eq. 3.6) and bending moment m = E_B (kappa - "
          "kappa_0) (eq. 3.8) in unbounded simple shear u = (k y, 0) imposed on all four faces (non-equilibrium "
-         "extrapolation), domain 16a x 16a, capsule at the centre, fine block [5a, 11a]^2 with spacing 0.05a, coarse "
-         "0.1a (thesis 3.1.2). Units: a = equivalent radius (area/pi)^0.5, velocity k a, time 1/k; Re = rho (2ka)(2a)/mu, "
-         "G = mu k a / E (eq. 3.9), E_b = E_B/(a^2 E) (eq. 3.10). Lattice velocity: the thesis uses 2ka = 1e-4 "
-         "(k a = 5e-5; tau_c = 0.62, tau_f = 0.74 at Re 0.05, BGK), kept by level thesis; standard uses "
-         "k a = 2e-4 with TRT (tau_c = 0.98, tau_f = 1.46: four times fewer steps; the Mach number stays "
-         "below 2e-3), ")
+         "extrapolation), domain 16a x 16a, capsule at the centre, fine block [5a, 11a]^2 with spacing 0.05a, "
+         "coarse 0.1a (thesis 3.1.2). Units: a = equivalent radius (area/pi)^0.5, velocity k a, time 1/k; "
+         "Re = rho (2ka)(2a)/mu, G = mu k a / E (eq. 3.9), E_b = E_B/(a^2 E) (eq. 3.10). Lattice velocity: the "
+         "thesis uses 2ka = 1e-4 (k a = 5e-5; tau_c = 0.62, tau_f = 0.74 at Re 0.05, BGK), kept by level thesis; "
+         "standard uses k a = 2e-4 with TRT (tau_c = 0.98, tau_f = 1.46: four times fewer steps; the Mach number "
+         "stays below 2e-3), ")
 QUICK_HALF = "quick doubles the spacing and the lattice velocity and halves the membrane nodes."
 
 
@@ -88,8 +88,9 @@ def case(cid, title, description, *, shape, G, re, end_time, average_from, Eb=0.
          series=SERIES, quick=None, quick_speedup=2, quick_keeps_nodes=False, quick_end=None,
          quick_snapshots=None, quick_average_from=None, thesis=THESIS_LEVEL, acceptance=(), performance=None):
     """One case file. `cid` is "chapter/name"; `shape` the shape's type and parameters (the centre and the
-    equivalent diameter 2 are added); `walls`: moving walls at y = 0 and the domain side with x periodic instead of the far field on
-    all faces. quick=None: the default half-resolution quick level (with the quick_* options)."""
+    equivalent diameter 2 are added); walls=True: moving walls at y = 0 and y = domain with x periodic instead
+    of the far field on all faces; quick=None: the default half-resolution quick level (with the quick_*
+    options), else the quick block itself."""
     assert domain % 2 == 0  # the centre stays an integer
     snapshots = list(snapshots) if snapshots else [end_time]
     grid = {"refinement": refinement, "fine_spacing": fine_spacing}
@@ -111,7 +112,8 @@ def case(cid, title, description, *, shape, G, re, end_time, average_from, Eb=0.
             "dimension": 2,
             "flow": {"type": "shear"},
             "reynolds": re,
-            "domain": {"size": [domain, domain], "boundaries": ["periodic", "wall"] if walls else ["far_field"] * 2},
+            "domain": {"size": [domain, domain],
+                       "boundaries": ["periodic", "wall"] if walls else ["far_field"] * 2},
             "bodies": [{"name": "capsule",
                         "shape": {"type": shape["type"], "center": [domain // 2] * 2, "diameter": 2,
                                   **{k: v for k, v in shape.items() if k != "type"}},
