@@ -7,9 +7,12 @@
 //  - wall (half-way bounce-back, Ladd 1994): the population that left towards the wall,
 //    reversed, plus the moving-wall term 2 w_i ρ0 (c_i·u_w)/cs²; the wall lies half way
 //    between the ghost and the interior node;
-//  - far field (non-equilibrium extrapolation, Guo, Zheng & Shi 2002): the ghost node gets
+//  - far field, one of two schemes (FarField), u_b being the imposed unperturbed flow:
+//    non-equilibrium extrapolation (Guo, Zheng & Shi 2002): the ghost node gets
 //    f = f_eq(ρ_f, u_b) + (f_f − f_eq(ρ_f, u_f)) from its nearest interior node f, is
-//    collided, and pushes into the interior; u_b is the imposed unperturbed flow;
+//    collided, and pushes into the interior; or equilibrium (thesis 2.2.1, "the density
+//    distribution function is set at its equilibrium state"): the ghost node holds
+//    f_eq(ρ0 = 1, u_b), so what enters is the unperturbed far-field state, whatever leaves;
 //  - interface: left to the multi-block coupling (refinement module).
 // All links are precomputed once; applying them touches only the block surface.
 // Far-field ghosts are stored as structure of arrays in memory order and processed in
@@ -30,6 +33,9 @@ namespace caplab::boundary {
 
 enum class Kind { periodic, far_field, wall, interface };
 
+/// How a far-field ghost node is set (see the file comment).
+enum class FarField { extrapolation, equilibrium };
+
 template <class L, class T>
 class BoundarySet {
  public:
@@ -39,7 +45,9 @@ class BoundarySet {
   using VelocityField = std::function<Vec<D>(const Vec<D>&)>;
 
   BoundarySet() = default;
-  BoundarySet(const field::Grid<D>& g, const std::array<Kind, D>& kinds, const VelocityField& imposed) {
+  BoundarySet(const field::Grid<D>& g, const std::array<Kind, D>& kinds, const VelocityField& imposed,
+              FarField far_field = FarField::extrapolation)
+      : far_field_(far_field) {
     CAPLAB_CHECK(g.size() <= std::numeric_limits<int>::max(),
                  "block too large for the far field's 32-bit node indices");
     field::for_each_ghost<D>(g, [&](const Index<D>& h) { add_ghost(g, kinds, imposed, h); });
@@ -55,8 +63,13 @@ class BoundarySet {
     for (const auto& c : copies_) next[c.dst] = next[c.src] + T(c.add);
     const T* current = pop.current();
     const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(far_interior_.size()) / batch;
+    if (far_field_ == FarField::equilibrium) {
 #pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t b = 0; b < batches; ++b) far_field_batch(current, next, N, op, b * batch);
+      for (std::ptrdiff_t b = 0; b < batches; ++b) far_field_batch<true>(current, next, N, op, b * batch);
+    } else {
+#pragma omp parallel for schedule(static)
+      for (std::ptrdiff_t b = 0; b < batches; ++b) far_field_batch<false>(current, next, N, op, b * batch);
+    }
   }
 
   bool empty() const { return copies_.empty() && far_interior_.empty(); }
@@ -74,25 +87,31 @@ class BoundarySet {
     std::ptrdiff_t dst;  // interior node receiving population i
   };
 
-  /// Guo's extrapolation and the collision of ghosts k0 … k0 + batch − 1, then their links.
-  template <class Op>
+  /// The post-collision state of ghosts k0 … k0 + batch − 1 (Guo's extrapolation and the
+  /// collision, or the far-field equilibrium, a fixed point of the collision), then their links.
+  template <bool Equilibrium, class Op>
   void far_field_batch(const T* __restrict current, T* __restrict next, std::ptrdiff_t N, const Op& op,
                        std::ptrdiff_t k0) const {
     T post[Q][batch];
 #pragma omp simd
     for (int b = 0; b < batch; ++b) {
-      T f[Q], feq_f[Q], feq_b[Q], fb[Q], out[Q], rho, u[D], ub[D];
-      // A 32-bit node index into population i's array: GCC 12 turns it into a vector gather;
-      // a 64-bit index into the whole buffer leaves the loop scalar.
-#pragma GCC unroll 19
-      for (int i = 0; i < Q; ++i) f[i] = (current + i * N)[far_interior_[k0 + b]];
-      collision::moments<L, T>(f, rho, u);
-      collision::equilibrium<L, T>(rho, u, feq_f);
+      T out[Q], ub[D];
       for (int a = 0; a < D; ++a) ub[a] = far_u_b_[a][k0 + b];
-      collision::equilibrium<L, T>(rho, ub, feq_b);
+      if constexpr (Equilibrium) {
+        collision::equilibrium<L, T>(T(1), ub, out);
+      } else {
+        T f[Q], feq_f[Q], feq_b[Q], fb[Q], rho, u[D];
+        // A 32-bit node index into population i's array: GCC 12 turns it into a vector gather;
+        // a 64-bit index into the whole buffer leaves the loop scalar.
 #pragma GCC unroll 19
-      for (int i = 0; i < Q; ++i) fb[i] = feq_b[i] + (f[i] - feq_f[i]);
-      op.template collide<L, T>(fb, feq_b, out);
+        for (int i = 0; i < Q; ++i) f[i] = (current + i * N)[far_interior_[k0 + b]];
+        collision::moments<L, T>(f, rho, u);
+        collision::equilibrium<L, T>(rho, u, feq_f);
+        collision::equilibrium<L, T>(rho, ub, feq_b);
+#pragma GCC unroll 19
+        for (int i = 0; i < Q; ++i) fb[i] = feq_b[i] + (f[i] - feq_f[i]);
+        op.template collide<L, T>(fb, feq_b, out);
+      }
 #pragma GCC unroll 19
       for (int i = 0; i < Q; ++i) post[i][b] = out[i];
     }
@@ -153,6 +172,7 @@ class BoundarySet {
     far_first_link_.push_back(static_cast<int>(far_links_.size()));
   }
 
+  FarField far_field_ = FarField::extrapolation;
   std::vector<Copy> copies_;
   // Far-field ghosts in the order of the ghost layer (memory order), padded to whole batches:
   // nearest interior node (extrapolation source), imposed velocity u_b, and the links of

@@ -48,6 +48,12 @@ void check_flow(const CaseSpec& spec, const CaseDiagnostics& diag) {
   if (flow.type == FlowSpec::Type::body_force && flow.body_force == 0)
     diag.fail("/physics/flow/body_force", json(flow.body_force),
               "a non-zero force density (along x, in rho U^2/L)");
+  // A far-field scheme other than the default with no far-field face would change nothing.
+  const auto& faces = spec.physics.boundaries;
+  if (spec.numerics.far_field != FarFieldScheme::extrapolation &&
+      std::find(faces.begin(), faces.end(), BoundaryType::far_field) == faces.end())
+    diag.fail("/numerics/far_field", json(enum_name(far_field_names, spec.numerics.far_field)),
+              "no numerics.far_field: no face of physics.domain.boundaries is far_field");
 }
 
 void check_grid(const CaseSpec& spec, const CaseDiagnostics& diag) {

@@ -66,6 +66,10 @@ inline constexpr std::array collision_names{
 inline constexpr std::array precision_names{EnumName<Precision>{"double", Precision::double_},
                                             EnumName<Precision>{"single", Precision::single}};
 
+inline constexpr std::array far_field_names{
+    EnumName<FarFieldScheme>{"extrapolation", FarFieldScheme::extrapolation},
+    EnumName<FarFieldScheme>{"equilibrium", FarFieldScheme::equilibrium}};
+
 inline constexpr std::array kernel_names{EnumName<IbSpec::Kernel>{"cosine4", IbSpec::Kernel::cosine4},
                                          EnumName<IbSpec::Kernel>{"roma3", IbSpec::Kernel::roma3},
                                          EnumName<IbSpec::Kernel>{"linear2", IbSpec::Kernel::linear2}};

@@ -140,6 +140,7 @@ SchemaNode build_case_schema() {
       opt("ib",
           object({opt("kernel", choice(enum_names(kernel_names))), opt("marker_spacing", number(closed(0.05, 2))),
                   opt("forcing_iterations", integer(closed(1, 100)))})),
+      opt("far_field", choice(enum_names(far_field_names))),
       req("lattice_velocity", number(Range{0, 0.4, true, false})),
       req("end_time", number(positive)),
       opt("threads", integer(closed(0, 4096))),

@@ -133,6 +133,9 @@ struct IbSpec {
 
 enum class Precision { double_, single };
 
+/// How the far-field faces impose the unperturbed flow (boundary/boundary_set.hpp).
+enum class FarFieldScheme { extrapolation, equilibrium };
+
 /// The checks every run makes while it goes (sim/scene.hpp check_guards): a run that leaves
 /// these bounds stops with exit code 3 instead of writing garbage.
 struct GuardSpec {
@@ -148,6 +151,7 @@ struct NumericsSpec {
   CollisionSpec collision;
   Precision precision = Precision::double_;
   IbSpec ib;
+  FarFieldScheme far_field = FarFieldScheme::extrapolation;
   double lattice_velocity = 0.1;  ///< U in lattice units (same on every block: acoustic scaling)
   double end_time = 1.0;          ///< in L/U
   int threads = 0;                ///< 0: OMP_NUM_THREADS, else the usable processors (CPU quota respected)

@@ -282,6 +282,7 @@ CaseSpec to_spec(const json& doc, const CaseDiagnostics& diag) {
     numerics.ib.kernel = enum_value(kernel_names, ib.at("kernel").get<std::string>());
   numerics.ib.marker_spacing = ib.value("marker_spacing", numerics.ib.marker_spacing);
   numerics.ib.forcing_iterations = ib.value("forcing_iterations", numerics.ib.forcing_iterations);
+  if (n.contains("far_field")) numerics.far_field = enum_value(far_field_names, n.at("far_field").get<std::string>());
   numerics.lattice_velocity = n.at("lattice_velocity").get<double>();
   numerics.end_time = n.at("end_time").get<double>();
   numerics.threads = n.value("threads", numerics.threads);
@@ -322,9 +323,9 @@ CaseSpec to_spec(const json& doc, const CaseDiagnostics& diag) {
     spec.acceptance.push_back(std::move(entry));
   }
   if (doc.contains("performance")) {
-    const json& p = doc.at("performance");
-    spec.performance = PerformanceSpec{p.at("wall_time_budget_s").get<std::map<std::string, double>>(),
-                                       p.at("justification").get<std::string>()};
+    const json& perf = doc.at("performance");
+    spec.performance = PerformanceSpec{perf.at("wall_time_budget_s").get<std::map<std::string, double>>(),
+                                       perf.at("justification").get<std::string>()};
   }
   return spec;
 }

@@ -45,6 +45,7 @@ class Fluid {
     field::Grid<D> coarse;
     std::optional<field::Grid<D>> fine;  // two-level when present
     std::array<boundary::Kind, D> boundaries{};
+    boundary::FarField far_field = boundary::FarField::extrapolation;
     std::function<Vec<D>(const Vec<D>&)> imposed_velocity_lu;  // at a physical position
     Op coarse_op;                        // its tau is the coarse relaxation time
     Vec<D> body_force_lu = Vec<D>::Zero();  // coarse lattice units
@@ -60,7 +61,7 @@ class Fluid {
       coupling_ = refinement::TwoLevel<L, T>(s.coarse, *s.fine, {s.coarse_op.tau, s.coarse_op.tau_minus()},
                                              {fine_op.tau, fine_op.tau_minus()});
     }
-    coarse_bc_ = boundary::BoundarySet<L, T>(s.coarse, s.boundaries, s.imposed_velocity_lu);
+    coarse_bc_ = boundary::BoundarySet<L, T>(s.coarse, s.boundaries, s.imposed_velocity_lu, s.far_field);
     const bool body = s.body_force_lu.norm() > 0;
     double scale = 1.0;
     for (std::size_t b = 0; b < blocks_.size(); ++b, scale *= 0.5) {

@@ -295,6 +295,8 @@ class Scene {
         case cases::BoundaryType::wall: s.boundaries[a] = boundary::Kind::wall; break;
       }
     }
+    s.far_field = spec.numerics.far_field == cases::FarFieldScheme::equilibrium ? boundary::FarField::equilibrium
+                                                                               : boundary::FarField::extrapolation;
     const double ulu = units.velocity_lu;
     s.imposed_velocity_lu = [spec, ulu](const Vec<D>& x) {
       const auto u = imposed_velocity(spec, std::vector<double>(x.data(), x.data() + D));
