@@ -22,9 +22,40 @@ def lattice_velocity(re, fine_per_a, tau_f):
     return round((tau_f - 0.5) / 3 * re / fine_per_a, 6)
 
 
+# The explicit membrane-fluid coupling is stable while the membrane's stiffest modulus in lattice units,
+# E_lu = nu_lu U_lu / G x stiffness_factor = U_lu^2 a_lu / (Re G) x stiffness_factor, stays small (C++:
+# sim::membrane_lattice_modulus; the limit make stress measured on the NH sphere is E_lu about 2-4). The
+# chapter 5 spheres run at 0.17 (standard) and 0.33 (quick). Measured failures: the biconcave cell at
+# G = 0.0005 with the default tau_f = 3.5 (E_lu = 25 at quick) blew up within a few hundred steps; before the
+# Skalak factor entered the rule, the chapter 6 biconcave cells at quick blew up at 6.5 (C = 23, 83 steps) and
+# 3.1 (C = 116, 3500 steps) and ran through at 2.5. E_MAX = 0.5 keeps a factor 4-8 below the limit: above it
+# the lattice velocity is lowered (smaller time steps, tau_f closer to 1/2) until E_lu = E_MAX.
+E_MAX = 0.5
+
+
+def stiffness_factor(law, C=None):
+    """How much stiffer than NH of the same E the law is at small strain in its stiffest in-plane mode (C++:
+    sim::membrane_stiffness_factor): 1 for NH and ZT; Skalak max(3/2, (1 + 2C)/2) (area modulus (2 + 4C) E
+    against NH's 4E; shear modulus E/2 against E/3)."""
+    return max(1.5, 0.5 * (1.0 + 2.0 * C)) if law == "skalak" else 1.0
+
+
+def stable_tau_f(re, a_lu, G, law, C=None, tau_f=3.5):
+    """tau_f of the fine grid (a_lu nodes per a): the given one, or lower where E_lu would pass E_MAX."""
+    u = min((tau_f - 0.5) / 3 * re / a_lu, math.sqrt(E_MAX * re * G / (a_lu * stiffness_factor(law, C))))
+    return round(0.5 + 3 * u * a_lu / re, 4)
+
+
+def stable_quick_speedup(re, a_lu, G, law, C, tau_f):
+    """Quick (half the resolution) multiplies the lattice velocity by 2 where E_lu allows it: at a_lu / 2 and
+    the same tau_f, E_lu doubles; above E_MAX the factor is lowered until E_lu = E_MAX."""
+    u = (tau_f - 0.5) / 3 * re / a_lu
+    return round(min(2.0, math.sqrt(E_MAX * re * G / (a_lu / 2 * stiffness_factor(law, C))) / u), 4)
+
+
 def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, fine, fine_per_a, subdivisions,
          end_time, average_from, walls=False, C=None, refinement="two_level", tau_f=3.5,
-         acceptance=(), quick_end=None, snapshots=(), quick_speedup=2, performance=None):
+         acceptance=(), quick_end=None, snapshots=(), quick_speedup=2, performance=None, quick_margin=0):
     u = lattice_velocity(re, fine_per_a, tau_f)
     membrane = {"law": law, "capillary": G, "subdivisions": subdivisions}
     if C is not None:
@@ -85,10 +116,12 @@ def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, f
     if quick_end:
         doc["fidelity"]["quick"]["outputs.snapshots.times"] = [0, quick_end]
     # The fine block's faces lie on coarse nodes: at the quick level's coarser grid, widen the
-    # block to the nearest ones outside (only grid20, at a/5, needs it).
+    # block to the nearest ones outside (only grid20, at a/5, needs it), and by quick_margin more
+    # coarse spacings on every side where the capsule needs the room (the IB stencil must stay 2
+    # fine nodes inside the block: at quick that is twice as far from the edge as at standard).
     coarse_quick = 4.0 / fine_per_a
-    snapped = fine and (math.floor(fine[0] / coarse_quick + 1e-9) * coarse_quick,
-                        math.ceil(fine[1] / coarse_quick - 1e-9) * coarse_quick)
+    snapped = fine and ((math.floor(fine[0] / coarse_quick + 1e-9) - quick_margin) * coarse_quick,
+                        (math.ceil(fine[1] / coarse_quick - 1e-9) + quick_margin) * coarse_quick)
     if refinement == "two_level" and any(abs(a - b) > 1e-9 for a, b in zip(snapped, fine)):
         doc["fidelity"]["quick"]["numerics.grid.fine_region.min"] = [round(snapped[0], 10)] * 3
         doc["fidelity"]["quick"]["numerics.grid.fine_region.max"] = [round(snapped[1], 10)] * 3

@@ -53,9 +53,11 @@ int check(const CheckArgs& args) {
     if (b.membrane) {
       const double E_lu = sim::membrane_lattice_modulus(u, b);
       const double limit = sim::membrane_stiffness_limit(spec.physics.dimension);
-      fmt::print("  membrane '{}': lattice modulus E_lu = nu U / G = {:.3g} (the explicit-coupling limit make stress "
+      const double factor = sim::membrane_stiffness_factor(*b.membrane);
+      fmt::print("  membrane '{}': lattice modulus E_lu = nu U / G{} = {:.3g} (the explicit-coupling limit make stress "
                  "measured without bending stiffness is about {:g}; bending stiffness lowers it)\n",
-                 b.name, E_lu, limit);
+                 b.name, factor == 1.0 ? "" : fmt::format(" x {:g} (Skalak: the area modulus, (1 + 2C)/2)", factor),
+                 E_lu, limit);
       if (E_lu > limit)
         fmt::print("  warning: the membrane of '{}' is likely too stiff for this time step and will blow up; lower "
                    "numerics.lattice_velocity (E_lu grows as its square)\n",

@@ -251,8 +251,14 @@ nlohmann::json LatticeUnits::to_json() const {
   return j;
 }
 
+double membrane_stiffness_factor(const cases::MembraneSpec& membrane) {
+  if (membrane.law != cases::MembraneSpec::Law::skalak) return 1.0;
+  return std::max(1.5, 0.5 * (1.0 + 2.0 * membrane.area_dilation));
+}
+
 double membrane_lattice_modulus(const LatticeUnits& units, const cases::BodySpec& body) {
-  return units.blocks.back().nu_lu * units.velocity_lu / body.membrane->capillary;
+  return units.blocks.back().nu_lu * units.velocity_lu / body.membrane->capillary *
+         membrane_stiffness_factor(*body.membrane);
 }
 
 }  // namespace caplab::sim

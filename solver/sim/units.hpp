@@ -86,7 +86,20 @@ void check_memory(const cases::CaseSpec& spec, const LatticeUnits& units, double
 /// membrane can blow up below it.
 inline double membrane_stiffness_limit(int dimension) { return dimension == 2 ? 5.0 : 2.0; }
 
-/// E_lu = nu_lu U_lu / G of a capsule body (the finest block's viscosity).
+/// How much stiffer than a neo-Hookean membrane of the same E a membrane law is at small
+/// strain, in its stiffest in-plane mode (the one the explicit coupling's limit is set by).
+/// With I1 = l1^2 + l2^2 - 2, I2 = l1^2 l2^2 - 1, an isotropic stretch l = 1 + e gives the
+/// area modulus d2W/dl2 = 4 W1 + 12 W2 + 16 (W11 + 2 W12 + W22) at l = 1: 4E for NH and ZT
+/// (eq. 5.1-5.2), (2 + 4C) E for Skalak (eq. 5.3); the shear moduli are E/3 (NH, ZT) and E/2
+/// (Skalak, E = 2 G_s). Factor: 1 for NH, ZT and the 2D Hooke ring, max(3/2, (1 + 2C)/2) for
+/// Skalak. Measured (ch6 biconcave cells at quick, 2026-12-03): Skalak C = 23 at nu U / G
+/// = 0.28 (factor 23.5, 6.5 in NH units) blew up within 83 steps, C = 116 at 0.027 (3.1) after
+/// 3500 steps; C = 187 at 0.013 (2.5) and C = 4.6 at 0.5 (2.55) ran through.
+double membrane_stiffness_factor(const cases::MembraneSpec& membrane);
+
+/// E_lu = nu_lu U_lu / G times membrane_stiffness_factor: a capsule body's stiffest membrane
+/// modulus in lattice units of the finest block, in the units of a neo-Hookean membrane (those
+/// of membrane_stiffness_limit).
 double membrane_lattice_modulus(const LatticeUnits& units, const cases::BodySpec& body);
 
 /// Imposed (unperturbed) velocity of the case's flow at position x (in L), in units of U.

@@ -3,6 +3,8 @@
 // machine's memory, and the refusal of runs whose step count no integer holds.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -12,6 +14,7 @@
 #include "../../fuzz/fuzz_input.hpp"
 #include "case/load_case.hpp"
 #include "core/error.hpp"
+#include "membrane/fem_membrane.hpp"
 #include "sim/units.hpp"
 
 namespace caplab::sim {
@@ -144,6 +147,68 @@ TEST(sim_units, FuzzRegressionsAreInputErrors) {
     ++replayed;
   }
   EXPECT_GE(replayed, 2);
+}
+
+// The stiffness factor of a law against NH of the same E is the ratio of its stiffest
+// small-strain mode, measured here by finite differences of the laws' own energies
+// (membrane/fem_membrane.hpp): the isotropic stretch (area modulus) and the pure shear.
+TEST(sim_units, MembraneStiffnessFactorIsTheLawsStiffestModeAgainstNeoHookean) {
+  auto energy = [](const membrane::MembraneLaw& law, double l1, double l2) {
+    const double I1 = l1 * l1 + l2 * l2 - 2.0, I2 = l1 * l1 * l2 * l2 - 1.0;
+    return std::visit([&](const auto& w) { return w.energy(I1, I2); }, law);
+  };
+  auto second_derivative = [&](const membrane::MembraneLaw& law, auto stretch) {
+    const double h = 1e-4;
+    auto W = [&](double e) {
+      const auto [l1, l2] = stretch(e);
+      return energy(law, l1, l2);
+    };
+    return (W(h) - 2.0 * W(0.0) + W(-h)) / (h * h);
+  };
+  auto isotropic = [](double e) { return std::pair{1.0 + e, 1.0 + e}; };
+  auto shear = [](double e) { return std::pair{1.0 + e, 1.0 / (1.0 + e)}; };
+  const double E = 1.0;
+  const membrane::MembraneLaw nh = membrane::NeoHookean{E};
+  for (double C : {0.1, 1.0, 23.0, 100.0, 400.0}) {
+    SCOPED_TRACE(C);
+    const membrane::MembraneLaw sk = membrane::Skalak{E, C};
+    const double area = second_derivative(sk, isotropic) / second_derivative(nh, isotropic);
+    const double shearing = second_derivative(sk, shear) / second_derivative(nh, shear);
+    cases::MembraneSpec spec;
+    spec.law = cases::MembraneSpec::Law::skalak;
+    spec.area_dilation = C;
+    EXPECT_NEAR(membrane_stiffness_factor(spec), std::max(area, shearing), 1e-5 * std::max(area, shearing));
+  }
+  for (auto law : {cases::MembraneSpec::Law::neo_hookean, cases::MembraneSpec::Law::zero_thickness,
+                   cases::MembraneSpec::Law::hooke}) {
+    cases::MembraneSpec spec;
+    spec.law = law;
+    EXPECT_EQ(membrane_stiffness_factor(spec), 1.0);
+  }
+  const membrane::MembraneLaw zt = membrane::ZeroThickness{E};
+  EXPECT_NEAR(second_derivative(zt, isotropic), second_derivative(nh, isotropic), 1e-6);
+  EXPECT_NEAR(second_derivative(zt, shear), second_derivative(nh, shear), 1e-6);
+}
+
+// No catalogue case, at any of its levels, runs a membrane above the explicit-coupling limit
+// make stress measured (a case that would blow up within its first hundreds of steps: the
+// chapter 6 biconcave cells did, at quick, before the Skalak factor entered the rule).
+TEST(sim_units, NoCatalogueMembraneIsAboveTheExplicitCouplingLimit) {
+  int membranes = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(source_dir / "catalogue")) {
+    if (entry.path().extension() != ".json" || entry.path().filename() == "schema.json") continue;
+    for (const auto& level : cases::fidelity_levels(entry.path())) {
+      const auto spec = cases::load_case(entry.path(), level);
+      const auto units = derive_units(spec);
+      for (const auto& b : spec.physics.bodies)
+        if (b.membrane) {
+          ++membranes;
+          EXPECT_LE(membrane_lattice_modulus(units, b), membrane_stiffness_limit(spec.physics.dimension))
+              << entry.path() << " at " << level << ", body " << b.name;
+        }
+    }
+  }
+  EXPECT_GT(membranes, 300);
 }
 
 }  // namespace
