@@ -77,4 +77,12 @@ CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const
 /// core::Error when fewer than 3 samples lie in the window or the lengths differ.
 std::optional<double> revolution_rate(std::span<const double> t, std::span<const double> phase, double t_from);
 
+/// The tank-treading frequency of thesis 6.3.1 from a tracked membrane node's phase, with t in
+/// 1/k: f / k = 2 pi / (k T), T the time of one whole revolution (the revolution_rate itself,
+/// not revolutions per unit time; Tran-Son-Tay et al. 1984 give 0.22 for young red cells, T = 28.6/k).
+inline std::optional<double> tank_treading_frequency_per_k(std::span<const double> t, std::span<const double> phase,
+                                                           double t_from) {
+  return revolution_rate(t, phase, t_from);
+}
+
 }  // namespace caplab::diagnostics

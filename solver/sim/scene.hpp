@@ -1007,12 +1007,12 @@ class Scene {
     } else if (const auto* phase = column("tank_treading_phase")) {
       // 3D: whole revolutions of the tracked node only (a part revolution on a deformed shape
       // turns unevenly, see above).
-      if (const auto rate = diagnostics::revolution_rate(t, *phase, from))
+      if (const auto f = diagnostics::tank_treading_frequency_per_k(t, *phase, from))
         metrics[prefix + "tank_treading_frequency_per_k"] = {
-            {"value", *rate / (2 * std::numbers::pi)},
+            {"value", *f},
             {"unit", "1"},
-            {"definition", "f / k: whole revolutions of the tracked node (series tank_treading_phase) per k t" +
-                               window + " (thesis ch. 6 normalisation)"}};
+            {"definition", "f / k = 2 pi / (k T), T the mean time of a whole revolution of the tracked node (series "
+                           "tank_treading_phase)" + window + " (thesis 6.3.1 normalisation)"}};
     }
   }
 

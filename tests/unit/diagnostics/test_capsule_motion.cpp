@@ -97,6 +97,18 @@ TEST(CapsuleMotion, JefferyOrbitTumblesWithItsPeriod) {
   EXPECT_NEAR(*p.tumbling_period, half_period, 1e-3 * half_period);
 }
 
+TEST(TankTreadingFrequency, IsTwoPiOverTheRevolutionTimeAsInThesisSection6_3_1) {
+  // A node revolving once every T = 28.6/k (t in 1/k) has f/k = 2 pi/(k T) = 0.22, the
+  // Tran-Son-Tay value the thesis compares with; not 1/(k T) = 0.035 (the summary reported
+  // that until 2026-12-03, 2 pi too small).
+  const double T = 28.6;
+  const auto s = sample(100, 1e-3, [&](double t) { return -2 * std::numbers::pi * t / T; });
+  const auto f = tank_treading_frequency_per_k(s.t, s.theta, 10.0);
+  ASSERT_TRUE(f.has_value());
+  EXPECT_NEAR(*f, 2 * std::numbers::pi / T, 1e-3);
+  EXPECT_NEAR(*f, 0.22, 0.0005);
+}
+
 TEST(RevolutionRate, CountsWholeTurnsOfAnUnevenPhase) {
   // A node turning clockwise at the mean rate 0.3 with a 40 % modulation per revolution (as on
   // a deformed contour): whole revolutions give the mean rate exactly, whatever the window.
