@@ -754,9 +754,10 @@ class Scene {
         const double E_lu = membrane_lattice_modulus(units_, b);
         if (E_lu > limit)
           return fmt::format("the membrane of '{}' is too stiff for the time step: its lattice modulus E_lu = nu U / G "
-                             "(x the law's stiffness factor, Skalak: (1 + 2C)/2) = {:.3g} is above the explicit-coupling limit measured by make stress (about {:g} in "
-                             "{}D); lower numerics.lattice_velocity (E_lu grows as its square; a finer grid at the same "
-                             "lattice velocity raises it)",
+                             "(times the law's stiffness factor, Skalak: (1 + 2C)/2) = {:.3g} is above the "
+                             "explicit-coupling limit measured by make stress (about {:g} in {}D); lower "
+                             "numerics.lattice_velocity (E_lu grows as its square; a finer grid at the same lattice "
+                             "velocity raises it)",
                              b.name, E_lu, limit, D);
       }
     if (tau < 0.55)

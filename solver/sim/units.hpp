@@ -93,8 +93,8 @@ inline double membrane_stiffness_limit(int dimension) { return dimension == 2 ? 
 /// (eq. 5.1-5.2), (2 + 4C) E for Skalak (eq. 5.3); the shear moduli are E/3 (NH, ZT) and E/2
 /// (Skalak, E = 2 G_s). Factor: 1 for NH, ZT and the 2D Hooke ring, max(3/2, (1 + 2C)/2) for
 /// Skalak. Measured (ch6 biconcave cells at quick, 2026-12-03): Skalak C = 23 at nu U / G
-/// = 0.28 (factor 23.5, 6.5 in NH units) blew up within 83 steps, C = 116 at 0.027 (3.1) after
-/// 3500 steps; C = 187 at 0.013 (2.5) and C = 4.6 at 0.5 (2.55) ran through.
+/// = 0.28 (factor 23.5, 6.5 in NH units) blew up within 83 steps, C = 120 at 0.027 (3.2) after
+/// 3500 steps; C = 190 at 0.013 (2.5) and C = 4.6 at 0.5 (2.55) ran through.
 double membrane_stiffness_factor(const cases::MembraneSpec& membrane);
 
 /// E_lu = nu_lu U_lu / G times membrane_stiffness_factor: a capsule body's stiffest membrane
