@@ -28,7 +28,7 @@ def lattice_velocity(re, fine_per_a, tau_f):
 # chapter 5 spheres run at 0.17 (standard) and 0.33 (quick). Measured failures: the biconcave cell at
 # G = 0.0005 with the default tau_f = 3.5 (E_lu = 25 at quick) blew up within a few hundred steps; before the
 # Skalak factor entered the rule, the chapter 6 biconcave cells at quick blew up at 6.5 (C = 23, 83 steps) and
-# 3.1 (C = 116, 3500 steps) and ran through at 2.5. E_MAX = 0.5 keeps a factor 4-8 below the limit: above it
+# 3.2 (C = 120, 3500 steps) and ran through at 2.5. E_MAX = 0.5 keeps a factor 4-8 below the limit: above it
 # the lattice velocity is lowered (smaller time steps, tau_f closer to 1/2) until E_lu = E_MAX.
 E_MAX = 0.5
 
@@ -46,11 +46,14 @@ def stable_tau_f(re, a_lu, G, law, C=None, tau_f=3.5):
     return round(0.5 + 3 * u * a_lu / re, 4)
 
 
-def stable_quick_speedup(re, a_lu, G, law, C, tau_f):
-    """Quick (half the resolution) multiplies the lattice velocity by 2 where E_lu allows it: at a_lu / 2 and
-    the same tau_f, E_lu doubles; above E_MAX the factor is lowered until E_lu = E_MAX."""
+def stable_time_step(re, a_lu, G, law, C=None, tau_f=3.5):
+    """case() keywords tau_f and quick_speedup from the rule: tau_f as given or lower where E_lu would pass
+    E_MAX; quick (half the resolution, where E_lu doubles at the same tau_f) multiplies the lattice velocity by 2,
+    or less, until E_lu = E_MAX."""
+    tau_f = stable_tau_f(re, a_lu, G, law, C, tau_f)
     u = (tau_f - 0.5) / 3 * re / a_lu
-    return round(min(2.0, math.sqrt(E_MAX * re * G / (a_lu / 2 * stiffness_factor(law, C))) / u), 4)
+    speedup = round(min(2.0, math.sqrt(E_MAX * re * G / (a_lu / 2 * stiffness_factor(law, C))) / u), 4)
+    return {"tau_f": tau_f, "quick_speedup": speedup}
 
 
 def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, fine, fine_per_a, subdivisions,
