@@ -89,8 +89,7 @@ class DirectForcing {
     velocity_.resize(m_count);
     for (std::size_t m = 0; m < m_count; ++m) {
       double r = 0.0;
-      const auto w = transfer_.stencil_weights(m);
-      for (int e = 0; e < S; ++e) r += w[e] * rho_loc_[slot_[m * S + e]];
+      for (int e = 0; e < S; ++e) r += w_[m * S + e] * rho_loc_[slot_[m * S + e]];
       rho_m_[m] = r;
     }
     for (int it = 0; it < iterations_; ++it) {
@@ -99,8 +98,7 @@ class DirectForcing {
         const Vec<D> d_force = 2.0 * rho_m_[m] * (desired_velocity_lu[m] - velocity_[m]);
         force_[m] += d_force;
         const Vec<D> fm = d_force * weight_[m];
-        const auto w = transfer_.stencil_weights(m);
-        for (int e = 0; e < S; ++e) f_loc_[slot_[m * S + e]] += w[e] * fm;
+        for (int e = 0; e < S; ++e) f_loc_[slot_[m * S + e]] += w_[m * S + e] * fm;
       }
     }
     interpolate_corrected();
@@ -149,29 +147,29 @@ class DirectForcing {
     Index<D> ijk;
   };
 
-  // The union of the stencil nodes (sorted, unique) and, per stencil entry, its slot in it.
+  // The stencil entries of every marker (linear index, node and weight, marker m at
+  // [m S, (m + 1) S)), the union of their nodes (sorted, unique) and each entry's slot in it.
   void build_local_nodes() {
     constexpr int S = Transfer<D, Kernel>::stencil_size;
     const std::size_t m_count = transfer_.marker_count();
-    local_.resize(m_count * S);
+    entry_.resize(m_count * S);
+    w_.resize(m_count * S);
     for (std::size_t m = 0; m < m_count; ++m) {
-      const auto ids = transfer_.stencil_nodes(m);
-      const auto ijk = transfer_.stencil_indices(m);
-      for (int e = 0; e < S; ++e) local_[m * S + e] = LocalNode{ids[e], ijk[e]};
+      std::size_t e = m * S;
+      transfer_.for_each_stencil_node(m, [&](const Index<D>& ijk, std::ptrdiff_t id, double w) {
+        entry_[e] = LocalNode{id, ijk};
+        w_[e++] = w;
+      });
     }
     auto by_id = [](const LocalNode& a, const LocalNode& b) { return a.id < b.id; };
+    local_ = entry_;
     std::sort(local_.begin(), local_.end(), by_id);
     local_.erase(std::unique(local_.begin(), local_.end(),
                              [](const LocalNode& a, const LocalNode& b) { return a.id == b.id; }),
                  local_.end());
     slot_.resize(m_count * S);
-    for (std::size_t m = 0; m < m_count; ++m) {
-      const auto ids = transfer_.stencil_nodes(m);
-      for (int e = 0; e < S; ++e) {
-        const auto it = std::lower_bound(local_.begin(), local_.end(), LocalNode{ids[e], {}}, by_id);
-        slot_[m * S + e] = it - local_.begin();
-      }
-    }
+    for (std::size_t e = 0; e < entry_.size(); ++e)
+      slot_[e] = std::lower_bound(local_.begin(), local_.end(), entry_[e], by_id) - local_.begin();
   }
 
   template <class VelocityAt, class DensityAt>
@@ -205,10 +203,9 @@ class DirectForcing {
 #pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold)
     for (std::ptrdiff_t m = 0; m < m_count; ++m) {
       Vec<D> u = Vec<D>::Zero();
-      const auto w = transfer_.stencil_weights(m);
       for (int e = 0; e < S; ++e) {
         const std::ptrdiff_t s = slot_[m * S + e];
-        u += w[e] * (u_loc_[s] + f_loc_[s] / (2.0 * rho_loc_[s]));
+        u += w_[m * S + e] * (u_loc_[s] + f_loc_[s] / (2.0 * rho_loc_[s]));
       }
       velocity_[m] = u;
     }
@@ -217,7 +214,8 @@ class DirectForcing {
   int iterations_;
   Transfer<D, Kernel> transfer_;
   std::vector<double> weight_;
-  std::vector<LocalNode> local_;
+  std::vector<LocalNode> entry_, local_;
+  std::vector<double> w_;  // stencil weights per entry
   std::vector<std::ptrdiff_t> slot_;
   std::vector<Vec<D>> u_loc_, f_loc_;
   std::vector<double> rho_loc_;

@@ -16,7 +16,12 @@
 //     the interior is an error (CAPLAB_CHECK) naming the marker, its position and the block.
 //     The check is on the whole support^D stencil, including nodes of zero weight.
 //   * Stencils are computed once per step by update() into member buffers that only grow,
-//     so the time loop does not allocate once the marker count is stable.
+//     so the time loop does not allocate once the marker count is stable. A stencil is
+//     stored compactly, per axis: the `support` node indices, their weights and their parts
+//     of the linear index (240 bytes per 3D marker); its support^D entries (node, linear
+//     index, weight w0 w1 [w2]) are formed where they are used (for_each_stencil_node).
+//     Storing the expanded entries (64 x 28 bytes per 3D marker) made update() a wall of
+//     stores and cost as much as spreading (solver/bench/NOTES.md).
 //   * Threads: update() and interpolation run in parallel over markers (OpenMP, for large
 //     marker counts); the callables passed to interpolate must be safe to call
 //     concurrently and must not throw. Spreading runs in parallel over slabs: spread()
@@ -29,9 +34,12 @@
 //     slab (markers in index order within a slab).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <iterator>
+#include <limits>
 #include <span>
 #include <sstream>
 #include <string>
@@ -42,6 +50,7 @@
 #include "core/vec.hpp"
 #include "field/grid.hpp"
 #include "ibm/kernels.hpp"
+#include "ibm/stencil_union.hpp"
 
 namespace caplab::ibm {
 
@@ -75,9 +84,7 @@ class Transfer {
     periodic_ = periodic;
     const std::ptrdiff_t m_count = static_cast<std::ptrdiff_t>(positions.size());
     x_lu_.resize(m_count);
-    node_.resize(m_count * stencil_size);
-    ijk_.resize(m_count * stencil_size);
-    w_.resize(m_count * stencil_size);
+    stencil_.resize(m_count);
     std::ptrdiff_t first_bad = m_count;
 #pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold) reduction(min : first_bad)
     for (std::ptrdiff_t m = 0; m < m_count; ++m) {
@@ -95,17 +102,53 @@ class Transfer {
   const std::array<bool, D>& periodic() const { return periodic_; }
   /// Marker position in lattice units (fractional node index), not wrapped.
   const Vec<D>& lattice_position(std::size_t m) const { return x_lu_[m]; }
-  /// Linear grid indices (grid.index) of the stencil nodes of marker m.
-  std::span<const std::ptrdiff_t> stencil_nodes(std::size_t m) const {
-    return {node_.data() + m * stencil_size, stencil_size};
+  /// Calls f(const Index<D>& node, std::ptrdiff_t linear_index, double weight) for the
+  /// support^D nodes of the stencil of marker m (nodes wrapped into the interior, linear
+  /// index as grid.index, weights phi(x - X_m) summing to 1), axis 0 fastest.
+  template <class F>
+  void for_each_stencil_node(std::size_t m, F&& f) const {
+    const Stencil& s = stencil_[m];
+    if constexpr (D == 2) {
+      for (int j = 0; j < support; ++j)
+        for (int i = 0; i < support; ++i)
+          f(Index<2>{s.i[0][i], s.i[1][j]}, s.off[0][i] + s.off[1][j], s.w[0][i] * s.w[1][j]);
+    } else {
+      for (int k = 0; k < support; ++k)
+        for (int j = 0; j < support; ++j)
+          for (int i = 0; i < support; ++i)
+            f(Index<3>{s.i[0][i], s.i[1][j], s.i[2][k]}, s.off[0][i] + s.off[1][j] + s.off[2][k],
+              s.w[0][i] * s.w[1][j] * s.w[2][k]);
+    }
   }
-  /// Node indices (wrapped into the interior) of the stencil of marker m.
-  std::span<const Index<D>> stencil_indices(std::size_t m) const {
-    return {ijk_.data() + m * stencil_size, stencil_size};
-  }
-  /// Kernel weights phi(x - X_m) of the stencil of marker m; they sum to 1.
-  std::span<const double> stencil_weights(std::size_t m) const {
-    return {w_.data() + m * stencil_size, stencil_size};
+
+  /// Marks every stencil node of every marker in `nodes` (in parallel for many markers): a
+  /// row along axis 0 at once where it is `support` consecutive nodes, else node by node.
+  void mark_stencil_nodes(StencilUnion& nodes) const {
+    const std::ptrdiff_t m_count = static_cast<std::ptrdiff_t>(marker_count());
+    const bool rows = nodes.runs_of(support);
+    std::ptrdiff_t lo = std::numeric_limits<std::ptrdiff_t>::max(), hi = -1;
+#pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold) reduction(min : lo) reduction(max : hi)
+    for (std::ptrdiff_t m = 0; m < m_count; ++m) {
+      const Stencil& s = stencil_[m];
+      if (rows && s.i[0][support - 1] == s.i[0][0] + support - 1) {  // not wrapped along axis 0
+        if constexpr (D == 2) {
+          for (int j = 0; j < support; ++j) nodes.mark_run(s.off[0][0] + s.off[1][j]);
+        } else {
+          for (int k = 0; k < support; ++k)
+            for (int j = 0; j < support; ++j) nodes.mark_run(s.off[0][0] + s.off[1][j] + s.off[2][k]);
+        }
+      } else {
+        for_each_stencil_node(m, [&](const Index<D>&, std::ptrdiff_t n, double) { nodes.mark_node(n); });
+      }
+      std::ptrdiff_t first = 0, last = 0;
+      for (int a = 0; a < D; ++a) {
+        first += *std::min_element(std::begin(s.off[a]), std::end(s.off[a]));
+        last += *std::max_element(std::begin(s.off[a]), std::end(s.off[a]));
+      }
+      lo = std::min(lo, first);
+      hi = std::max(hi, last);
+    }
+    if (m_count > 0) nodes.widen(lo, hi);
   }
 
   /// out[m] = sum_x u(x) phi(x - X_m) (eq. 2.19 / 5.11), with
@@ -120,9 +163,6 @@ class Transfer {
   void interpolate_scalar(ValueAt&& value_at, std::span<double> out) const {
     gather<double>(value_at, out);
   }
-
-  /// Linear grid indices of the stencils of all markers (marker m at [m * stencil_size, ...)).
-  std::span<const std::ptrdiff_t> all_stencil_nodes() const { return {node_.data(), x_lu_.size() * stencil_size}; }
 
   /// f(x) += sum_m force_density[m] weight_lu[m] phi(x - X_m) (eq. 2.16 / 5.8), with the
   /// force per unit marker measure and the marker measure in lattice units. In parallel over
@@ -140,12 +180,9 @@ class Transfer {
       for (std::size_t k = slab_start_[slab]; k < slab_start_[slab + 1]; ++k) {
         const std::size_t m = order_[k];
         const Vec<D> fm = force_density[m] * weight_lu[m];
-        const std::size_t base = m * stencil_size;
-        for (int e = 0; e < stencil_size; ++e) {
-          const std::ptrdiff_t id = node_[base + e];
-          const double w = w_[base + e];
+        for_each_stencil_node(m, [&](const Index<D>&, std::ptrdiff_t id, double w) {
           for (int a = 0; a < D; ++a) f.comp[a][id] += w * fm[a];
-        }
+        });
       }
     };
     const int slabs = slab_count();
@@ -161,6 +198,14 @@ class Transfer {
   }
 
  private:
+  // The stencil of one marker, per axis: node indices (wrapped into the interior), kernel
+  // weights, and the nodes' parts (i + 1) * stride of the linear index.
+  struct Stencil {
+    int i[D][support];
+    double w[D][support];
+    std::ptrdiff_t off[D][support];
+  };
+
   template <class T, class ValueAt>
   void gather(ValueAt& value_at, std::span<T> out) const {
     CAPLAB_CHECK(out.size() == marker_count(),
@@ -173,8 +218,7 @@ class Transfer {
         acc = T(0);
       else
         acc = T::Zero();
-      const std::ptrdiff_t base = m * stencil_size;
-      for (int e = 0; e < stencil_size; ++e) acc += w_[base + e] * value_at(ijk_[base + e], node_[base + e]);
+      for_each_stencil_node(m, [&](const Index<D>& ijk, std::ptrdiff_t id, double w) { acc += w * value_at(ijk, id); });
       out[m] = acc;
     }
   }
@@ -186,8 +230,7 @@ class Transfer {
 
   // Fills the stencil of marker m; false if it leaves the interior along a non-periodic axis.
   bool fill_stencil(std::ptrdiff_t m) {
-    double w1[D][support];
-    std::array<std::array<int, support>, D> i1;
+    Stencil& st = stencil_[m];
     for (int a = 0; a < D; ++a) {
       const int n = grid_.n()[a];
       double x = x_lu_[m][a];
@@ -196,26 +239,12 @@ class Transfer {
       const double lo = first_node(x);
       if (!periodic_[a] && (lo < 0.0 || lo + support - 1 > n - 1)) return false;
       const int i0 = static_cast<int>(lo);
-      Kernel::weights(x - i0, w1[a]);
+      Kernel::weights(x - i0, st.w[a]);
       for (int s = 0; s < support; ++s) {
         const int i = i0 + s;
-        i1[a][s] = periodic_[a] ? ((i % n) + n) % n : i;
+        st.i[a][s] = periodic_[a] ? ((i % n) + n) % n : i;
+        st.off[a][s] = (st.i[a][s] + 1) * grid_.stride(a);
       }
-    }
-    const std::ptrdiff_t base = m * stencil_size;
-    for (int e = 0; e < stencil_size; ++e) {
-      Index<D> ijk;
-      double w = 1.0;
-      int rest = e;
-      for (int a = 0; a < D; ++a) {
-        const int s = rest % support;
-        rest /= support;
-        ijk[a] = i1[a][s];
-        w *= w1[a][s];
-      }
-      ijk_[base + e] = ijk;
-      node_[base + e] = grid_.index(ijk);
-      w_[base + e] = w;
     }
     return true;
   }
@@ -229,7 +258,7 @@ class Transfer {
   void sort_into_slabs() {
     const int slabs = slab_count();
     const std::size_t m_count = marker_count();
-    auto slab_of = [&](std::size_t m) { return ijk_[m * stencil_size][D - 1] / support; };
+    auto slab_of = [&](std::size_t m) { return stencil_[m].i[D - 1][0] / support; };
     slab_start_.assign(slabs + 1, 0);
     order_.resize(m_count);
     for (std::size_t m = 0; m < m_count; ++m) ++slab_start_[slab_of(m) + 1];
@@ -277,9 +306,7 @@ class Transfer {
   field::Grid<D> grid_;
   std::array<bool, D> periodic_{};
   std::vector<Vec<D>> x_lu_;
-  std::vector<std::ptrdiff_t> node_;
-  std::vector<Index<D>> ijk_;
-  std::vector<double> w_;
+  std::vector<Stencil> stencil_;
   std::vector<std::size_t> slab_start_, order_;  // markers by slab (sort_into_slabs)
 };
 

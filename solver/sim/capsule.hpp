@@ -64,9 +64,9 @@ class Capsule {
   /// Node velocities of the last advect() (lattice units).
   std::span<const Vec<D>> velocities() const { return U_; }
 
-  /// Linear indices of the nodes of the stencils of the last spread() (with repeats).
-  std::span<const std::ptrdiff_t> stencil_nodes() const {
-    return std::visit([](const auto& tr) { return tr.all_stencil_nodes(); }, transfer_);
+  /// Marks the nodes of the stencils of the last spread() in `nodes`.
+  void mark_stencil_nodes(ibm::StencilUnion& nodes) const {
+    std::visit([&](const auto& tr) { tr.mark_stencil_nodes(nodes); }, transfer_);
   }
 
   /// Step 1: the membrane forces at the current positions.

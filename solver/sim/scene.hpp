@@ -12,7 +12,6 @@
 #pragma once
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdint>
@@ -476,39 +475,19 @@ class Scene {
   }
 
   /// forced_nodes_ = the union of the current stencils of all bodies and capsules, each node
-  /// once and in memory order; slot_[n] is the position of node n in it. The stencil nodes are
-  /// marked in a byte mask (in parallel: every thread stores the same 1), then the mask is read
-  /// back over the range they span. Memory order lets the forced collision and the velocity
-  /// gather walk the block's rows instead of jumping between the rows of each stencil
-  /// (measured: unsorted, the forced collision of a 3D capsule's ~10k stencil nodes cost five
-  /// unforced updates per node); the scan replaced a sort that cost as much as the spread.
+  /// once and in memory order (ibm::StencilUnion); slot_[n] is the position of node n in it.
+  /// Memory order lets the forced collision and the velocity gather walk the block's rows
+  /// instead of jumping between the rows of each stencil (measured: unsorted, the forced
+  /// collision of a 3D capsule's ~10k stencil nodes cost five unforced updates per node).
   void collect_forced_nodes(std::ptrdiff_t grid_size) {
-    if (static_cast<std::ptrdiff_t>(slot_.size()) != grid_size) {
-      slot_.assign(grid_size, 0);
-      mark_.assign(grid_size, 0);
-    }
-    std::ptrdiff_t lo = grid_size, hi = -1;
-    auto mark = [&](std::span<const std::ptrdiff_t> nodes) {
-      const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(nodes.size());
-      std::uint8_t* mask = mark_.data();
-#pragma omp parallel for schedule(static) if (count > 4096) reduction(min : lo) reduction(max : hi)
-      for (std::ptrdiff_t e = 0; e < count; ++e) {
-        const std::ptrdiff_t n = nodes[e];
-        std::atomic_ref<std::uint8_t>(mask[n]).store(1, std::memory_order_relaxed);
-        lo = std::min(lo, n);
-        hi = std::max(hi, n);
-      }
-    };
+    if (static_cast<std::ptrdiff_t>(slot_.size()) != grid_size) slot_.assign(grid_size, 0);
+    stencil_union_.begin(grid_size);
     for (const auto& b : bodies_)
-      std::visit([&](const auto& forcing) { mark(forcing.transfer().all_stencil_nodes()); }, b.forcing);
-    for (const auto& c : capsules_) mark(c.stencil_nodes());
+      std::visit([&](const auto& forcing) { forcing.transfer().mark_stencil_nodes(stencil_union_); }, b.forcing);
+    for (const auto& c : capsules_) c.mark_stencil_nodes(stencil_union_);
     forced_nodes_.clear();
-    for (std::ptrdiff_t n = lo; n <= hi; ++n)
-      if (mark_[n]) {
-        mark_[n] = 0;
-        slot_[n] = static_cast<std::int32_t>(forced_nodes_.size());
-        forced_nodes_.push_back(n);
-      }
+    stencil_union_.collect(forced_nodes_);
+    for (std::size_t k = 0; k < forced_nodes_.size(); ++k) slot_[forced_nodes_[k]] = static_cast<std::int32_t>(k);
   }
 
   /// Membrane forces, spreading, and the markers' move with the forced velocity (capsule.hpp).
@@ -1027,7 +1006,7 @@ class Scene {
   // the forced velocity at those nodes; buffers only grow.
   std::vector<std::ptrdiff_t> forced_nodes_;
   std::vector<std::int32_t> slot_;
-  std::vector<std::uint8_t> mark_;  // all zero between calls of collect_forced_nodes
+  ibm::StencilUnion stencil_union_;
   std::vector<Vec<D>> velocity_;
   std::vector<CapsuleTrack<D>> capsule_tracks_;
   std::array<bool, D> periodic_{};

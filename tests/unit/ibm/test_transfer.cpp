@@ -3,7 +3,9 @@
 // out-of-block error, and buffer reuse.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <omp.h>
 #include <random>
@@ -84,7 +86,9 @@ TYPED_TEST(TransferTest, InterpolationAndSpreadingAreAdjoint) {
   });
   EXPECT_NEAR(lagrangian, eulerian, 1e-13 * scale);
   // The comparator must be able to fail: a perturbed field breaks the identity.
-  f.comp[0][g.index(t.stencil_indices(0)[1])] += 1e-3;
+  std::vector<std::ptrdiff_t> nodes0;
+  t.for_each_stencil_node(0, [&](const Index<D>&, std::ptrdiff_t id, double) { nodes0.push_back(id); });
+  f.comp[0][nodes0[1]] += 1e-3;
   const double perturbed = sum_interior<D>(g, 0.0, [&](const Index<D>&, std::ptrdiff_t id) {
     double s = 0.0;
     for (int a = 0; a < D; ++a) s += u[id][a] * f.comp[a][id];
@@ -109,7 +113,14 @@ TYPED_TEST(TransferTest, SpreadingConservesForceAndLeavesGhostsAlone) {
   t.update(g, periodic_flags<TypeParam>(), x);
   for (std::size_t m = 0; m < x.size(); ++m) {
     double s = 0.0;
-    for (double we : t.stencil_weights(m)) s += we;
+    int count = 0;
+    t.for_each_stencil_node(m, [&](const Index<D>& ijk, std::ptrdiff_t id, double we) {
+      EXPECT_EQ(id, g.index(ijk));
+      EXPECT_TRUE(g.is_interior(ijk));
+      s += we;
+      ++count;
+    });
+    EXPECT_EQ(count, (Transfer<D, typename TypeParam::Kernel>::stencil_size));
     EXPECT_NEAR(s, 1.0, 1e-14);
   }
   field::VectorField<D> f(g.size());
@@ -149,10 +160,9 @@ TYPED_TEST(TransferTest, SpreadDoesNotDependOnTheThreadCount) {
   const auto one = spread_with(1), three = spread_with(3);
   field::VectorField<D> serial(g.size());
   for (std::size_t m = 0; m < x.size(); ++m) {
-    const auto nodes = t.stencil_nodes(m);
-    const auto weights = t.stencil_weights(m);
-    for (std::size_t e = 0; e < nodes.size(); ++e)
-      for (int a = 0; a < D; ++a) serial.comp[a][nodes[e]] += weights[e] * force[m][a] * w[m];
+    t.for_each_stencil_node(m, [&](const Index<D>&, std::ptrdiff_t id, double we) {
+      for (int a = 0; a < D; ++a) serial.comp[a][id] += we * force[m][a] * w[m];
+    });
   }
   for (int a = 0; a < D; ++a)
     for (std::ptrdiff_t n = 0; n < g.size(); ++n) {
@@ -252,17 +262,53 @@ TEST(TransferErrors, StencilOutsideNonPeriodicBlockIsReported) {
   EXPECT_THROW(t.update(g, {true, true, true}, std::vector<Vec<3>>{Vec<3>(std::nan(""), 0, 0)}), core::Error);
 }
 
-TEST(TransferBuffers, UpdateReusesStorage) {
+TEST(TransferMark, TheUnionIsExactlyTheStencilNodesInMemoryOrder) {
+  // The forced collision runs on the union: every stencil node once, also those of rows that
+  // wrap around a periodic axis 0 (marked node by node) and those of a second transfer with
+  // another support (node by node too), and no other node.
   const auto g = make_grid<3>(12);
-  std::mt19937 rng(1);
+  std::mt19937 rng(5);
   Transfer<3, Cosine4> t;
-  t.update(g, {true, true, true}, random_positions<3>(g, 50, 0.0, 12.0, rng));
-  const auto* nodes = t.stencil_nodes(0).data();
-  const auto* weights = t.stencil_weights(0).data();
-  t.update(g, {true, true, true}, random_positions<3>(g, 50, 0.0, 12.0, rng));
-  EXPECT_EQ(t.stencil_nodes(0).data(), nodes);
-  EXPECT_EQ(t.stencil_weights(0).data(), weights);
-  EXPECT_EQ(t.stencil_nodes(0).size(), 64u);
+  t.update(g, {true, false, true}, random_positions<3>(g, 300, 2.0, 9.0, rng));
+  auto wrapped = random_positions<3>(g, 20, 2.0, 9.0, rng);
+  for (auto& x : wrapped) x[0] = g.origin()[0] + g.dx() * 0.3;  // stencil rows wrap along x
+  t.update(g, {true, false, true}, [&] {
+    auto all = random_positions<3>(g, 300, 2.0, 9.0, rng);
+    all.insert(all.end(), wrapped.begin(), wrapped.end());
+    return all;
+  }());
+  Transfer<3, Roma3> r;
+  r.update(g, {true, false, true}, random_positions<3>(g, 30, 2.0, 9.0, rng));
+  std::vector<std::uint8_t> expected(g.size(), 0);
+  auto expect = [&](const auto& tr) {
+    for (std::size_t m = 0; m < tr.marker_count(); ++m)
+      tr.for_each_stencil_node(m, [&](const Index<3>&, std::ptrdiff_t id, double) { expected[id] = 1; });
+  };
+  expect(t);
+  expect(r);
+  std::vector<std::ptrdiff_t> want;
+  for (std::ptrdiff_t n = 0; n < g.size(); ++n)
+    if (expected[n]) want.push_back(n);
+  StencilUnion u;
+  for (int pass = 0; pass < 2; ++pass) {  // the second pass checks that collect() cleared the masks
+    u.begin(g.size());
+    t.mark_stencil_nodes(u);
+    r.mark_stencil_nodes(u);
+    std::vector<std::ptrdiff_t> got;
+    u.collect(got);
+    EXPECT_EQ(got, want) << "pass " << pass;
+  }
+  // Marking only the Roma3 transfer gives its stencils alone (runs of 3 this time).
+  std::fill(expected.begin(), expected.end(), 0);
+  expect(r);
+  want.clear();
+  for (std::ptrdiff_t n = 0; n < g.size(); ++n)
+    if (expected[n]) want.push_back(n);
+  u.begin(g.size());
+  r.mark_stencil_nodes(u);
+  std::vector<std::ptrdiff_t> got;
+  u.collect(got);
+  EXPECT_EQ(got, want);
 }
 
 TEST(TransferUnits, MeasureToLattice) {
