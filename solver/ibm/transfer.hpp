@@ -130,13 +130,8 @@ class Transfer {
 #pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold) reduction(min : lo) reduction(max : hi)
     for (std::ptrdiff_t m = 0; m < m_count; ++m) {
       const Stencil& s = stencil_[m];
-      if (rows && s.i[0][support - 1] == s.i[0][0] + support - 1) {  // not wrapped along axis 0
-        if constexpr (D == 2) {
-          for (int j = 0; j < support; ++j) nodes.mark_run(s.off[0][0] + s.off[1][j]);
-        } else {
-          for (int k = 0; k < support; ++k)
-            for (int j = 0; j < support; ++j) nodes.mark_run(s.off[0][0] + s.off[1][j] + s.off[2][k]);
-        }
+      if (rows && s.rows) {
+        for_each_stencil_row(m, [&](std::ptrdiff_t first, const double (&)[support]) { nodes.mark_run(first); });
       } else {
         for_each_stencil_node(m, [&](const Index<D>&, std::ptrdiff_t n, double) { nodes.mark_node(n); });
       }
@@ -156,6 +151,37 @@ class Transfer {
   template <class VelocityAt>
   void interpolate(VelocityAt&& velocity_at, std::span<Vec<D>> out) const {
     gather<Vec<D>>(velocity_at, out);
+  }
+  /// out[m] = sum_x u(x) phi(x - X_m) from a vector field on the grid of the last update()
+  /// (only the stencil nodes are read). Rows of consecutive nodes as vector code: the sums
+  /// differ from the callable form's at round-off.
+  void interpolate_field(const field::VectorField<D>& u, std::span<Vec<D>> out) const {
+    CAPLAB_CHECK(out.size() == marker_count(),
+                 "IB interpolation: the output needs one entry per marker (as in the last update)");
+    CAPLAB_CHECK(static_cast<std::ptrdiff_t>(u.comp[0].size()) == grid_.size(),
+                 "IB interpolation: the field is not sized for the grid of the last update");
+    const std::ptrdiff_t m_count = static_cast<std::ptrdiff_t>(marker_count());
+#pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold)
+    for (std::ptrdiff_t m = 0; m < m_count; ++m) {
+      Vec<D> acc = Vec<D>::Zero();
+      if (stencil_[m].rows) {
+        double lane[D][support] = {};  // per component and row position, summed at the end
+        for_each_stencil_row(m, [&](std::ptrdiff_t first, const double (&w)[support]) {
+          for (int a = 0; a < D; ++a) {
+            const double* __restrict__ row = u.comp[a].data() + first;
+#pragma omp simd
+            for (int i = 0; i < support; ++i) lane[a][i] += w[i] * row[i];
+          }
+        });
+        for (int a = 0; a < D; ++a)
+          for (int i = 0; i < support; ++i) acc[a] += lane[a][i];
+      } else {
+        for_each_stencil_node(m, [&](const Index<D>&, std::ptrdiff_t id, double w) {
+          for (int a = 0; a < D; ++a) acc[a] += w * u.comp[a][id];
+        });
+      }
+      out[m] = acc;
+    }
   }
   /// Interpolation of a scalar field: out[m] = sum_x s(x) phi(x - X_m), with
   /// s = value_at(const Index<D>& node, std::ptrdiff_t linear_index) -> double.
@@ -180,9 +206,19 @@ class Transfer {
       for (std::size_t k = slab_start_[slab]; k < slab_start_[slab + 1]; ++k) {
         const std::size_t m = order_[k];
         const Vec<D> fm = force_density[m] * weight_lu[m];
-        for_each_stencil_node(m, [&](const Index<D>&, std::ptrdiff_t id, double w) {
-          for (int a = 0; a < D; ++a) f.comp[a][id] += w * fm[a];
-        });
+        if (stencil_[m].rows) {  // rows of consecutive nodes: vector code, same sums as below
+          for_each_stencil_row(m, [&](std::ptrdiff_t first, const double (&w)[support]) {
+            for (int a = 0; a < D; ++a) {
+              double* __restrict__ row = f.comp[a].data() + first;
+#pragma omp simd
+              for (int i = 0; i < support; ++i) row[i] += w[i] * fm[a];
+            }
+          });
+        } else {
+          for_each_stencil_node(m, [&](const Index<D>&, std::ptrdiff_t id, double w) {
+            for (int a = 0; a < D; ++a) f.comp[a][id] += w * fm[a];
+          });
+        }
       }
     };
     const int slabs = slab_count();
@@ -204,7 +240,30 @@ class Transfer {
     int i[D][support];
     double w[D][support];
     std::ptrdiff_t off[D][support];
+    bool rows;  // not wrapped along axis 0: its rows are support consecutive linear indices
   };
+
+  // For a stencil that does not wrap along axis 0 (Stencil::rows): calls
+  // f(std::ptrdiff_t first, const double (&w)[support]) for each of its rows along axis 0, the
+  // nodes first .. first + support - 1 with the weights of for_each_stencil_node (the same
+  // products in the same order), rows in the order of for_each_stencil_node.
+  template <class F>
+  void for_each_stencil_row(std::size_t m, F&& f) const {
+    const Stencil& s = stencil_[m];
+    double w[support];
+    if constexpr (D == 2) {
+      for (int j = 0; j < support; ++j) {
+        for (int i = 0; i < support; ++i) w[i] = s.w[0][i] * s.w[1][j];
+        f(s.off[0][0] + s.off[1][j], w);
+      }
+    } else {
+      for (int k = 0; k < support; ++k)
+        for (int j = 0; j < support; ++j) {
+          for (int i = 0; i < support; ++i) w[i] = s.w[0][i] * s.w[1][j] * s.w[2][k];
+          f(s.off[0][0] + s.off[1][j] + s.off[2][k], w);
+        }
+    }
+  }
 
   template <class T, class ValueAt>
   void gather(ValueAt& value_at, std::span<T> out) const {
@@ -242,10 +301,12 @@ class Transfer {
       Kernel::weights(x - i0, st.w[a]);
       for (int s = 0; s < support; ++s) {
         const int i = i0 + s;
-        st.i[a][s] = periodic_[a] ? ((i % n) + n) % n : i;
+        // x is in [0, n), so i is in [-1, n + 2]: one wrap suffices unless n < support.
+        st.i[a][s] = !periodic_[a] ? i : n >= support ? (i < 0 ? i + n : i >= n ? i - n : i) : ((i % n) + n) % n;
         st.off[a][s] = (st.i[a][s] + 1) * grid_.stride(a);
       }
     }
+    st.rows = st.i[0][support - 1] == st.i[0][0] + support - 1;
     return true;
   }
 

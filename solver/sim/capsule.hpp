@@ -91,12 +91,11 @@ class Capsule {
     ar(prefix + "X", std::span<double>(X_.data()->data(), X_.size() * D));
   }
 
-  /// Steps 3 and 4: interpolates velocity_at(const Index<D>&, std::ptrdiff_t) -> Vec<D>
-  /// (lattice units, safe to call concurrently) at the nodes and moves them by one time step
-  /// of the block of spacing `dx` (in L): X += U dx.
-  template <class VelocityAt>
-  void advect(VelocityAt&& velocity_at, double dx) {
-    std::visit([&](const auto& tr) { tr.interpolate(velocity_at, std::span<Vec<D>>(U_)); }, transfer_);
+  /// Steps 3 and 4: interpolates the velocity field `u` (lattice units, on the grid of the
+  /// last spread(); only the stencil nodes are read) at the nodes and moves them by one time
+  /// step of the block of spacing `dx` (in L): X += U dx.
+  void advect(const field::VectorField<D>& u, double dx) {
+    std::visit([&](const auto& tr) { tr.interpolate_field(u, std::span<Vec<D>>(U_)); }, transfer_);
     for (std::size_t m = 0; m < X_.size(); ++m) X_[m] += U_[m] * dx;
   }
 

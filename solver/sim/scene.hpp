@@ -475,19 +475,17 @@ class Scene {
   }
 
   /// forced_nodes_ = the union of the current stencils of all bodies and capsules, each node
-  /// once and in memory order (ibm::StencilUnion); slot_[n] is the position of node n in it.
+  /// once and in memory order (ibm::StencilUnion).
   /// Memory order lets the forced collision and the velocity gather walk the block's rows
   /// instead of jumping between the rows of each stencil (measured: unsorted, the forced
   /// collision of a 3D capsule's ~10k stencil nodes cost five unforced updates per node).
   void collect_forced_nodes(std::ptrdiff_t grid_size) {
-    if (static_cast<std::ptrdiff_t>(slot_.size()) != grid_size) slot_.assign(grid_size, 0);
     stencil_union_.begin(grid_size);
     for (const auto& b : bodies_)
       std::visit([&](const auto& forcing) { forcing.transfer().mark_stencil_nodes(stencil_union_); }, b.forcing);
     for (const auto& c : capsules_) c.mark_stencil_nodes(stencil_union_);
     forced_nodes_.clear();
     stencil_union_.collect(forced_nodes_);
-    for (std::size_t k = 0; k < forced_nodes_.size(); ++k) slot_[forced_nodes_[k]] = static_cast<std::int32_t>(k);
   }
 
   /// Membrane forces, spreading, and the markers' move with the forced velocity (capsule.hpp).
@@ -499,16 +497,18 @@ class Scene {
       for (auto& c : capsules_) guarded(c, [&] { c.spread(pop.grid(), periodic_, f); });
       // The velocity the forced collision uses, once per stencil node (stencils overlap).
       collect_forced_nodes(pop.grid().size());
-      velocity_.resize(forced_nodes_.size());
+      // Written into a block-sized field (only at the stencil nodes, which are all the
+      // interpolation reads), so that the interpolation reads rows of consecutive nodes.
+      if (static_cast<std::ptrdiff_t>(forced_velocity_.comp[0].size()) != pop.grid().size())
+        forced_velocity_ = field::VectorField<D>(pop.grid().size());
       const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(forced_nodes_.size());
 #pragma omp parallel for schedule(static) if (count > 256)
       for (std::ptrdiff_t k = 0; k < count; ++k) {
         const std::ptrdiff_t n = forced_nodes_[k];
         const auto m = collision::node_moments<L, T>(pop, n);
-        for (int a = 0; a < D; ++a) velocity_[k][a] = m.u[a] + f.comp[a][n] / (2.0 * m.rho);
+        for (int a = 0; a < D; ++a) forced_velocity_.comp[a][n] = m.u[a] + f.comp[a][n] / (2.0 * m.rho);
       }
-      auto velocity = [&](const Index<D>&, std::ptrdiff_t n) { return velocity_[slot_[n]]; };
-      for (auto& c : capsules_) c.advect(velocity, pop.grid().dx());
+      for (auto& c : capsules_) c.advect(forced_velocity_, pop.grid().dx());
     });
   }
 
@@ -1005,9 +1005,8 @@ class Scene {
   // The union of the IB stencils of the current step (collect_forced_nodes) and, for capsules,
   // the forced velocity at those nodes; buffers only grow.
   std::vector<std::ptrdiff_t> forced_nodes_;
-  std::vector<std::int32_t> slot_;
   ibm::StencilUnion stencil_union_;
-  std::vector<Vec<D>> velocity_;
+  field::VectorField<D> forced_velocity_;  // u* + f / (2 rho) at forced_nodes_ (stale elsewhere)
   std::vector<CapsuleTrack<D>> capsule_tracks_;
   std::array<bool, D> periodic_{};
   std::vector<io::SeriesColumn> columns_;
