@@ -1,9 +1,9 @@
 // The union of the immersed-boundary stencils of a step: each node once, in memory order.
 //
 // The forced collision and the velocity gather run on the nodes that some stencil touches.
-// Stencils overlap heavily (a 3D capsule's 4098 markers reach ~15k distinct nodes through
-// 262k stencil entries), so the union is marked in byte masks over the block and read back
-// over the range the stencils span (a sort of the entries cost as much as spreading).
+// Stencils overlap heavily (a 3D capsule of 4098 markers has 262k stencil entries, many times
+// its distinct nodes), so the union is marked in byte masks over the block and read back over
+// the range the stencils span (a sort of the entries cost as much as spreading).
 // A stencil row along axis 0 is `run` consecutive linear indices unless it wraps around a
 // periodic axis 0: such rows are marked once, at their first node, in `run_start_`, and the
 // read-back extends each start over `run` nodes; nodes of wrapped rows go one by one into
@@ -11,8 +11,8 @@
 // a chapter 6 biconcave step; solver/bench/NOTES.md).
 //
 // Threads: mark_run and mark_node store 1 with relaxed atomic stores, so concurrent marking
-// (every thread writes the same value) is race-free; widen and collect are serial. Invariant: both masks are all zero between collect()
-// calls.
+// (every thread writes the same value) is race-free; widen and collect are serial.
+// Invariant: both masks are all zero between collect() calls.
 #pragma once
 
 #include <algorithm>
