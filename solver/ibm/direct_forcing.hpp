@@ -147,29 +147,29 @@ class DirectForcing {
     Index<D> ijk;
   };
 
-  // The stencil entries of every marker (linear index, node and weight, marker m at
-  // [m S, (m + 1) S)), the union of their nodes (sorted, unique) and each entry's slot in it.
+  // The weights of every stencil entry (marker m at [m S, (m + 1) S)), the union of the
+  // stencil nodes (sorted, unique) and each entry's slot in it.
   void build_local_nodes() {
     constexpr int S = Transfer<D, Kernel>::stencil_size;
     const std::size_t m_count = transfer_.marker_count();
-    entry_.resize(m_count * S);
+    local_.resize(m_count * S);
     w_.resize(m_count * S);
+    slot_.resize(m_count * S);
     for (std::size_t m = 0; m < m_count; ++m) {
       std::size_t e = m * S;
       transfer_.for_each_stencil_node(m, [&](const Index<D>& ijk, std::ptrdiff_t id, double w) {
-        entry_[e] = LocalNode{id, ijk};
+        local_[e] = LocalNode{id, ijk};
+        slot_[e] = id;  // the node for now, its slot below
         w_[e++] = w;
       });
     }
     auto by_id = [](const LocalNode& a, const LocalNode& b) { return a.id < b.id; };
-    local_ = entry_;
     std::sort(local_.begin(), local_.end(), by_id);
     local_.erase(std::unique(local_.begin(), local_.end(),
                              [](const LocalNode& a, const LocalNode& b) { return a.id == b.id; }),
                  local_.end());
-    slot_.resize(m_count * S);
-    for (std::size_t e = 0; e < entry_.size(); ++e)
-      slot_[e] = std::lower_bound(local_.begin(), local_.end(), entry_[e], by_id) - local_.begin();
+    for (auto& s : slot_)
+      s = std::lower_bound(local_.begin(), local_.end(), LocalNode{s, {}}, by_id) - local_.begin();
   }
 
   template <class VelocityAt, class DensityAt>
@@ -214,7 +214,7 @@ class DirectForcing {
   int iterations_;
   Transfer<D, Kernel> transfer_;
   std::vector<double> weight_;
-  std::vector<LocalNode> entry_, local_;
+  std::vector<LocalNode> local_;
   std::vector<double> w_;  // stencil weights per entry
   std::vector<std::ptrdiff_t> slot_;
   std::vector<Vec<D>> u_loc_, f_loc_;

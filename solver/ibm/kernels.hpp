@@ -5,8 +5,8 @@
 // and `weights(d, w)` the support weights w[s] = phi(d - s) of the stencil whose first node
 // lies d behind the marker (what the transfer computes per marker and axis; the cosine
 // kernel gets all four from one polynomial sine and cosine). The D-dimensional kernel is
-// the tensor product phi(x) phi(y) [phi(z)] (thesis eq. 2.18 / 5.9). Kernels are even, vanish for |r| >= support / 2 and have unit
-// integral.
+// the tensor product phi(x) phi(y) [phi(z)] (thesis eq. 2.18 / 5.9). Kernels are even,
+// vanish for |r| >= support / 2 and have unit integral.
 //
 // Discrete moment properties, for every marker position x (sums over the nodes i):
 //   kernel    sum phi(x-i)   sum (x-i) phi(x-i)             sum phi(x-i)^2
@@ -39,21 +39,28 @@ struct Cosine4 {
     const double a = std::abs(r);
     return a < 2.0 ? 0.25 * (1.0 + std::cos(0.5 * std::numbers::pi * a)) : 0.0;
   }
-  /// d in [1, 2] (the transfer's first node lies 1 <= d < 2 behind): cos(pi (d - s)/2) for
-  /// s = 0..3 is c, s, -c, -s with c = cos(theta), s = sin(theta), theta = pi d / 2. With
+  /// d in [1, 2) (the transfer's first node lies d behind the marker): cos(pi (d - k) / 2)
+  /// for k = 0..3 is c, s, -c, -s with c = cos(theta), s = sin(theta), theta = pi d / 2. With
   /// theta = 3 pi / 4 + p, |p| <= pi / 4, both follow from cos p and sin p, here their Taylor
   /// series to p^16 and p^17 (truncation below 1e-17, so the weights agree with phi() to
   /// round-off): no libm call, which was 7 % of a chapter 6 biconcave step (three sincos per
   /// marker and step; solver/bench/NOTES.md).
   static void weights(double d, double (&w)[support]) {
+    // Taylor coefficients of sin(p) / p and cos(p) in q = p^2, highest power first.
+    static constexpr double sin_c[] = {1.0 / 355687428096000, -1.0 / 1307674368000, 1.0 / 6227020800,
+                                       -1.0 / 39916800,       1.0 / 362880,          -1.0 / 5040,
+                                       1.0 / 120,             -1.0 / 6,              1.0};
+    static constexpr double cos_c[] = {1.0 / 20922789888000, -1.0 / 87178291200, 1.0 / 479001600,
+                                       -1.0 / 3628800,       1.0 / 40320,         -1.0 / 720,
+                                       1.0 / 24,             -1.0 / 2,            1.0};
     const double p = 0.5 * std::numbers::pi * (d - 1.5);
     const double q = p * p;
-    const double sin_p =
-        p * (1.0 + q * (-1.0 / 6 + q * (1.0 / 120 + q * (-1.0 / 5040 + q * (1.0 / 362880 + q * (-1.0 / 39916800 +
-            q * (1.0 / 6227020800 + q * (-1.0 / 1307674368000 + q * (1.0 / 355687428096000)))))))));
-    const double cos_p =
-        1.0 + q * (-1.0 / 2 + q * (1.0 / 24 + q * (-1.0 / 720 + q * (1.0 / 40320 + q * (-1.0 / 3628800 +
-            q * (1.0 / 479001600 + q * (-1.0 / 87178291200 + q * (1.0 / 20922789888000))))))));
+    double sin_p = 0.0, cos_p = 0.0;
+    for (int k = 0; k < 9; ++k) {
+      sin_p = sin_p * q + sin_c[k];
+      cos_p = cos_p * q + cos_c[k];
+    }
+    sin_p *= p;
     const double h = 0.5 * std::numbers::sqrt2;  // cos(3 pi/4) = -h, sin(3 pi/4) = h
     const double c = -h * (cos_p + sin_p), s = h * (cos_p - sin_p);
     w[0] = 0.25 * (1.0 + c);

@@ -5,10 +5,10 @@
 // its distinct nodes), so the union is marked in byte masks over the block and read back over
 // the range the stencils span (a sort of the entries cost as much as spreading).
 // A stencil row along axis 0 is `run` consecutive linear indices unless it wraps around a
-// periodic axis 0: such rows are marked once, at their first node, in `run_start_`, and the
-// read-back extends each start over `run` nodes; nodes of wrapped rows go one by one into
-// `single_`. One store per row instead of per node (measured: the per-node stores were 6 % of
-// a chapter 6 biconcave step; solver/bench/NOTES.md).
+// periodic axis 0. Rows that do not wrap are marked once, at their first node, in
+// `run_start_`, and the read-back extends each start over `run` nodes; the nodes of rows that
+// wrap go one by one into `single_`. One store per row instead of per node (measured: the
+// per-node stores were 6 % of a chapter 6 biconcave step; solver/bench/NOTES.md).
 //
 // Threads: mark_run and mark_node store 1 with relaxed atomic stores, so concurrent marking
 // (every thread writes the same value) is race-free; widen and collect are serial.
@@ -62,14 +62,20 @@ class StencilUnion {
         left = run_;
         run_start_[n] = 0;
       }
-      if (left > 0 || single_[n]) nodes.push_back(n);
-      single_[n] = 0;
+      if (single_[n]) {
+        single_[n] = 0;
+        nodes.push_back(n);
+      } else if (left > 0) {
+        nodes.push_back(n);
+      }
       if (left > 0) --left;
     }
   }
 
  private:
-  static void store_one(std::uint8_t& b) { std::atomic_ref<std::uint8_t>(b).store(1, std::memory_order_relaxed); }
+  static void store_one(std::uint8_t& b) {
+    std::atomic_ref<std::uint8_t>(b).store(1, std::memory_order_relaxed);
+  }
 
   std::vector<std::uint8_t> run_start_, single_;
   int run_ = 0;  // 0: not chosen yet

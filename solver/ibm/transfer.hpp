@@ -18,12 +18,12 @@
 //   * Stencils are computed once per step by update() into member buffers that only grow,
 //     so the time loop does not allocate once the marker count is stable. A stencil is
 //     stored compactly, per axis: the `support` node indices, their weights and their parts
-//     of the linear index (240 bytes per 3D marker); its support^D entries (node, linear
+//     of the linear index (248 bytes per 3D marker); its support^D entries (node, linear
 //     index, weight w0 w1 [w2]) are formed where they are used (for_each_stencil_node).
 //     Storing the expanded entries (64 x 28 bytes per 3D marker) made update() a wall of
 //     stores and cost as much as spreading (solver/bench/NOTES.md).
-//   * Threads: update() and interpolation run in parallel over markers (OpenMP, for large
-//     marker counts); the callables passed to interpolate must be safe to call
+//   * Threads: update(), interpolation and mark_stencil_nodes() run in parallel over markers
+//     (OpenMP, for large marker counts); the callables passed to interpolate must be safe to call
 //     concurrently and must not throw. Spreading runs in parallel over slabs: spread()
 //     first sorts the markers (stably) by the slab of `support` nodes along the last axis in
 //     which their stencil starts. A node is reached from at most two consecutive slabs, so
@@ -127,11 +127,13 @@ class Transfer {
     const std::ptrdiff_t m_count = static_cast<std::ptrdiff_t>(marker_count());
     const bool rows = nodes.runs_of(support);
     std::ptrdiff_t lo = std::numeric_limits<std::ptrdiff_t>::max(), hi = -1;
-#pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold) reduction(min : lo) reduction(max : hi)
+#pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold) \
+    reduction(min : lo) reduction(max : hi)
     for (std::ptrdiff_t m = 0; m < m_count; ++m) {
       const Stencil& s = stencil_[m];
       if (rows && s.rows) {
-        for_each_stencil_row(m, [&](std::ptrdiff_t first, const double (&)[support]) { nodes.mark_run(first); });
+        for_each_stencil_row(m,
+                             [&](std::ptrdiff_t first, const double(&)[support]) { nodes.mark_run(first); });
       } else {
         for_each_stencil_node(m, [&](const Index<D>&, std::ptrdiff_t n, double) { nodes.mark_node(n); });
       }
@@ -152,8 +154,8 @@ class Transfer {
   void interpolate(VelocityAt&& velocity_at, std::span<Vec<D>> out) const {
     gather<Vec<D>>(velocity_at, out);
   }
-  /// out[m] = sum_x u(x) phi(x - X_m) from a vector field on the grid of the last update()
-  /// (only the stencil nodes are read). Rows of consecutive nodes as vector code: the sums
+  /// out[m] = sum_x u(x) phi(x - X_m) (eq. 2.19 / 5.11) from a vector field on the grid of the
+  /// last update() (only the stencil nodes are read). Rows of consecutive nodes as vector code: the sums
   /// differ from the callable form's at round-off.
   void interpolate_field(const field::VectorField<D>& u, std::span<Vec<D>> out) const {
     CAPLAB_CHECK(out.size() == marker_count(),
@@ -166,7 +168,7 @@ class Transfer {
       Vec<D> acc = Vec<D>::Zero();
       if (stencil_[m].rows) {
         double lane[D][support] = {};  // per component and row position, summed at the end
-        for_each_stencil_row(m, [&](std::ptrdiff_t first, const double (&w)[support]) {
+        for_each_stencil_row(m, [&](std::ptrdiff_t first, const double(&w)[support]) {
           for (int a = 0; a < D; ++a) {
             const double* __restrict__ row = u.comp[a].data() + first;
 #pragma omp simd
@@ -207,7 +209,7 @@ class Transfer {
         const std::size_t m = order_[k];
         const Vec<D> fm = force_density[m] * weight_lu[m];
         if (stencil_[m].rows) {  // rows of consecutive nodes: vector code, same sums as below
-          for_each_stencil_row(m, [&](std::ptrdiff_t first, const double (&w)[support]) {
+          for_each_stencil_row(m, [&](std::ptrdiff_t first, const double(&w)[support]) {
             for (int a = 0; a < D; ++a) {
               double* __restrict__ row = f.comp[a].data() + first;
 #pragma omp simd
@@ -244,7 +246,7 @@ class Transfer {
   };
 
   // For a stencil that does not wrap along axis 0 (Stencil::rows): calls
-  // f(std::ptrdiff_t first, const double (&w)[support]) for each of its rows along axis 0, the
+  // f(std::ptrdiff_t first, const double(&w)[support]) for each of its rows along axis 0, the
   // nodes first .. first + support - 1 with the weights of for_each_stencil_node (the same
   // products in the same order), rows in the order of for_each_stencil_node.
   template <class F>
@@ -277,7 +279,8 @@ class Transfer {
         acc = T(0);
       else
         acc = T::Zero();
-      for_each_stencil_node(m, [&](const Index<D>& ijk, std::ptrdiff_t id, double w) { acc += w * value_at(ijk, id); });
+      for_each_stencil_node(
+          m, [&](const Index<D>& ijk, std::ptrdiff_t id, double w) { acc += w * value_at(ijk, id); });
       out[m] = acc;
     }
   }
@@ -287,22 +290,33 @@ class Transfer {
   // support / 2, of weight zero, when x - support / 2 is an integer).
   static double first_node(double x) { return std::floor(x - 0.5 * support) + 1.0; }
 
-  // Fills the stencil of marker m; false if it leaves the interior along a non-periodic axis.
+  // A lattice coordinate beyond this is a diverged marker (finite, but no block is this large,
+  // and wrapping it into a periodic axis would lose all its digits).
+  static constexpr double max_lattice_coordinate = 1 << 30;
+
+  // Fills the stencil of marker m; false if it leaves the interior along a non-periodic axis or
+  // its position has diverged.
   bool fill_stencil(std::ptrdiff_t m) {
     Stencil& st = stencil_[m];
     for (int a = 0; a < D; ++a) {
       const int n = grid_.n()[a];
       double x = x_lu_[m][a];
-      if (!std::isfinite(x)) return false;
-      if (periodic_[a]) x -= n * std::floor(x / n);  // into [0, n): same weights, wrapped nodes
+      if (!(std::abs(x) < max_lattice_coordinate)) return false;  // also NaN
+      if (periodic_[a]) x -= n * std::floor(x / n);  // into [0, n] (n for a tiny negative x): same weights
       const double lo = first_node(x);
       if (!periodic_[a] && (lo < 0.0 || lo + support - 1 > n - 1)) return false;
       const int i0 = static_cast<int>(lo);
       Kernel::weights(x - i0, st.w[a]);
       for (int s = 0; s < support; ++s) {
         const int i = i0 + s;
-        // x is in [0, n), so i is in [-1, n + 2]: one wrap suffices unless n < support.
-        st.i[a][s] = !periodic_[a] ? i : n >= support ? (i < 0 ? i + n : i >= n ? i - n : i) : ((i % n) + n) % n;
+        // x in [0, n] gives i in [-support / 2, n + support / 2]: one wrap suffices when
+        // n >= support.
+        if (!periodic_[a])
+          st.i[a][s] = i;
+        else if (n >= support)
+          st.i[a][s] = i < 0 ? i + n : i >= n ? i - n : i;
+        else
+          st.i[a][s] = ((i % n) + n) % n;
         st.off[a][s] = (st.i[a][s] + 1) * grid_.stride(a);
       }
     }
@@ -346,8 +360,9 @@ class Transfer {
     msg << " interior nodes, origin " << vec(grid_.origin()) << ", dx " << grid_.dx() << ": ";
     for (int a = 0; a < D; ++a) {
       const double x = x_lu_[m][a];
-      if (!std::isfinite(x)) {
-        msg << "the position is not finite along axis " << a
+      if (!(std::abs(x) < max_lattice_coordinate)) {
+        msg << "the position is not finite or beyond " << max_lattice_coordinate
+            << " lattice units along axis " << a
             << " (the markers have diverged: reduce the time step or check the membrane forces)";
         return msg.str();
       }

@@ -1,6 +1,8 @@
 // IB transfer: adjointness of interpolation and spreading (2D, 3D, every kernel, with and
-// without periodic wrap), exactness on polynomials, conservation, periodic wrap, the
-// out-of-block error, and buffer reuse.
+// without periodic wrap), exactness on polynomials, conservation, periodic wrap (also on a
+// periodic axis shorter than the stencil), the interpolation from a field against the
+// node-by-node form, the out-of-block and diverged-marker errors, and the union of the
+// stencil nodes (ibm/stencil_union.hpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -193,7 +195,9 @@ TYPED_TEST(TransferTest, FieldInterpolationEqualsTheCallableForm) {
         return v;
       },
       by_node);
-  for (std::size_t m = 0; m < x.size(); ++m) EXPECT_LT((by_field[m] - by_node[m]).norm(), 1e-15) << "marker " << m;
+  const double tol = 1e-16 * Transfer<D, typename TypeParam::Kernel>::stencil_size;  // sums of that many
+  for (std::size_t m = 0; m < x.size(); ++m)
+    EXPECT_LT((by_field[m] - by_node[m]).norm(), tol) << "marker " << m;
 }
 
 TYPED_TEST(TransferTest, InterpolationExactOnUniformAndLinearFields) {
@@ -283,8 +287,26 @@ TEST(TransferErrors, StencilOutsideNonPeriodicBlockIsReported) {
       t.update(g, {false, false, false}, std::vector<Vec<3>>{g.origin() + 0.5 * Vec<3>(7.5, 4, 4)}));
   EXPECT_THROW(t.update(g, {false, false, false}, std::vector<Vec<3>>{g.origin() + 0.5 * Vec<3>(4, 4, 8.0)}),
                core::Error);
-  // Diverged markers are reported, not turned into out-of-range indices.
+  // Diverged markers are reported, not turned into out-of-range indices: not finite, or finite
+  // but too far out for the periodic wrap to keep any digit.
   EXPECT_THROW(t.update(g, {true, true, true}, std::vector<Vec<3>>{Vec<3>(std::nan(""), 0, 0)}), core::Error);
+  EXPECT_THROW(t.update(g, {true, true, true}, std::vector<Vec<3>>{Vec<3>(1e300, 0, 0)}), core::Error);
+  EXPECT_THROW(t.update(g, {true, true, true}, std::vector<Vec<3>>{Vec<3>(0, -3e17, 0)}), core::Error);
+}
+
+// The linear indices of the stencil nodes of the transfers, each once, in increasing order.
+template <class... Transfers>
+std::vector<std::ptrdiff_t> stencil_node_set(std::ptrdiff_t grid_size, const Transfers&... transfers) {
+  std::vector<std::uint8_t> hit(grid_size, 0);
+  auto add = [&](const auto& tr) {
+    for (std::size_t m = 0; m < tr.marker_count(); ++m)
+      tr.for_each_stencil_node(m, [&](const auto&, std::ptrdiff_t id, double) { hit[id] = 1; });
+  };
+  (add(transfers), ...);
+  std::vector<std::ptrdiff_t> nodes;
+  for (std::ptrdiff_t n = 0; n < grid_size; ++n)
+    if (hit[n]) nodes.push_back(n);
+  return nodes;
 }
 
 TEST(TransferMark, TheUnionIsExactlyTheStencilNodesInMemoryOrder) {
@@ -293,27 +315,17 @@ TEST(TransferMark, TheUnionIsExactlyTheStencilNodesInMemoryOrder) {
   // another support (node by node too), and no other node.
   const auto g = make_grid<3>(12);
   std::mt19937 rng(5);
+  auto x = random_positions<3>(g, 300, 2.0, 9.0, rng);
+  for (int k = 0; k < 20; ++k) {  // stencil rows that wrap along x, at both ends
+    Vec<3> p = random_positions<3>(g, 1, 2.0, 9.0, rng)[0];
+    p[0] = g.origin()[0] + g.dx() * (k % 2 ? 0.3 : 11.6);
+    x.push_back(p);
+  }
   Transfer<3, Cosine4> t;
-  t.update(g, {true, false, true}, random_positions<3>(g, 300, 2.0, 9.0, rng));
-  auto wrapped = random_positions<3>(g, 20, 2.0, 9.0, rng);
-  for (auto& x : wrapped) x[0] = g.origin()[0] + g.dx() * 0.3;  // stencil rows wrap along x
-  t.update(g, {true, false, true}, [&] {
-    auto all = random_positions<3>(g, 300, 2.0, 9.0, rng);
-    all.insert(all.end(), wrapped.begin(), wrapped.end());
-    return all;
-  }());
+  t.update(g, {true, false, true}, x);
   Transfer<3, Roma3> r;
   r.update(g, {true, false, true}, random_positions<3>(g, 30, 2.0, 9.0, rng));
-  std::vector<std::uint8_t> expected(g.size(), 0);
-  auto expect = [&](const auto& tr) {
-    for (std::size_t m = 0; m < tr.marker_count(); ++m)
-      tr.for_each_stencil_node(m, [&](const Index<3>&, std::ptrdiff_t id, double) { expected[id] = 1; });
-  };
-  expect(t);
-  expect(r);
-  std::vector<std::ptrdiff_t> want;
-  for (std::ptrdiff_t n = 0; n < g.size(); ++n)
-    if (expected[n]) want.push_back(n);
+  const auto want = stencil_node_set(g.size(), t, r);
   StencilUnion u;
   for (int pass = 0; pass < 2; ++pass) {  // the second pass checks that collect() cleared the masks
     u.begin(g.size());
@@ -324,16 +336,34 @@ TEST(TransferMark, TheUnionIsExactlyTheStencilNodesInMemoryOrder) {
     EXPECT_EQ(got, want) << "pass " << pass;
   }
   // Marking only the Roma3 transfer gives its stencils alone (runs of 3 this time).
-  std::fill(expected.begin(), expected.end(), 0);
-  expect(r);
-  want.clear();
-  for (std::ptrdiff_t n = 0; n < g.size(); ++n)
-    if (expected[n]) want.push_back(n);
   u.begin(g.size());
   r.mark_stencil_nodes(u);
   std::vector<std::ptrdiff_t> got;
   u.collect(got);
-  EXPECT_EQ(got, want);
+  EXPECT_EQ(got, stencil_node_set(g.size(), r));
+}
+
+TEST(TransferPeriodic, AxisShorterThanTheStencilWrapsEveryNode) {
+  // A periodic axis of 2 nodes under a 4-node stencil: every node index wraps into 0..1, the
+  // weights of the nodes that coincide add up (partition of unity), and the union holds them.
+  const field::Grid<3> g(Index<3>{2, 9, 9}, Vec<3>::Zero(), 1.0);
+  Transfer<3, Cosine4> t;
+  t.update(g, {true, true, true}, std::vector<Vec<3>>{Vec<3>(0.3, 4.2, 4.7), Vec<3>(1.9, 8.6, 0.1)});
+  for (std::size_t m = 0; m < 2; ++m) {
+    double sum = 0.0;
+    t.for_each_stencil_node(m, [&](const Index<3>& ijk, std::ptrdiff_t id, double w) {
+      EXPECT_TRUE(g.is_interior(ijk));
+      EXPECT_EQ(id, g.index(ijk));
+      sum += w;
+    });
+    EXPECT_NEAR(sum, 1.0, 1e-14);
+  }
+  StencilUnion u;
+  u.begin(g.size());
+  t.mark_stencil_nodes(u);
+  std::vector<std::ptrdiff_t> got;
+  u.collect(got);
+  EXPECT_EQ(got, stencil_node_set(g.size(), t));
 }
 
 TEST(TransferUnits, MeasureToLattice) {
