@@ -309,6 +309,17 @@ std::vector<std::ptrdiff_t> stencil_node_set(std::ptrdiff_t grid_size, const Tra
   return nodes;
 }
 
+// What StencilUnion collects after the transfers mark their stencils into it.
+template <class... Transfers>
+std::vector<std::ptrdiff_t> collected_union(StencilUnion& u, std::ptrdiff_t grid_size,
+                                            const Transfers&... transfers) {
+  u.begin(grid_size);
+  (transfers.mark_stencil_nodes(u), ...);
+  std::vector<std::ptrdiff_t> nodes;
+  u.collect(nodes);
+  return nodes;
+}
+
 TEST(TransferMark, TheUnionIsExactlyTheStencilNodesInMemoryOrder) {
   // The forced collision runs on the union: every stencil node once, also those of rows that
   // wrap around a periodic axis 0 (marked node by node) and those of a second transfer with
@@ -327,20 +338,10 @@ TEST(TransferMark, TheUnionIsExactlyTheStencilNodesInMemoryOrder) {
   r.update(g, {true, false, true}, random_positions<3>(g, 30, 2.0, 9.0, rng));
   const auto want = stencil_node_set(g.size(), t, r);
   StencilUnion u;
-  for (int pass = 0; pass < 2; ++pass) {  // the second pass checks that collect() cleared the masks
-    u.begin(g.size());
-    t.mark_stencil_nodes(u);
-    r.mark_stencil_nodes(u);
-    std::vector<std::ptrdiff_t> got;
-    u.collect(got);
-    EXPECT_EQ(got, want) << "pass " << pass;
-  }
+  // The second pass checks that collect() cleared the masks.
+  for (int pass = 0; pass < 2; ++pass) EXPECT_EQ(collected_union(u, g.size(), t, r), want) << "pass " << pass;
   // Marking only the Roma3 transfer gives its stencils alone (runs of 3 this time).
-  u.begin(g.size());
-  r.mark_stencil_nodes(u);
-  std::vector<std::ptrdiff_t> got;
-  u.collect(got);
-  EXPECT_EQ(got, stencil_node_set(g.size(), r));
+  EXPECT_EQ(collected_union(u, g.size(), r), stencil_node_set(g.size(), r));
 }
 
 TEST(TransferPeriodic, AxisShorterThanTheStencilWrapsEveryNode) {
@@ -359,11 +360,7 @@ TEST(TransferPeriodic, AxisShorterThanTheStencilWrapsEveryNode) {
     EXPECT_NEAR(sum, 1.0, 1e-14);
   }
   StencilUnion u;
-  u.begin(g.size());
-  t.mark_stencil_nodes(u);
-  std::vector<std::ptrdiff_t> got;
-  u.collect(got);
-  EXPECT_EQ(got, stencil_node_set(g.size(), t));
+  EXPECT_EQ(collected_union(u, g.size(), t), stencil_node_set(g.size(), t));
 }
 
 TEST(TransferUnits, MeasureToLattice) {
