@@ -16,10 +16,15 @@ def fmt(x):
     return f"{x:g}"
 
 
-def lattice_velocity(re, fine_per_a, tau_f):
+def exact_lattice_velocity(re, fine_per_a, tau_f):
     """k a in lattice units that puts the fine block at relaxation time tau_f:
     nu_f = (tau_f - 1/2)/3 = U a_f / Re with a_f = a / dx_f."""
-    return round((tau_f - 0.5) / 3 * re / fine_per_a, 6)
+    return (tau_f - 0.5) / 3 * re / fine_per_a
+
+
+def lattice_velocity(re, fine_per_a, tau_f):
+    """exact_lattice_velocity as the case files write it (6 decimals)."""
+    return round(exact_lattice_velocity(re, fine_per_a, tau_f), 6)
 
 
 # The explicit membrane-fluid coupling is stable while the membrane's stiffest modulus in lattice units,
@@ -42,7 +47,7 @@ def stiffness_factor(law, C=None):
 
 def stable_tau_f(re, a_lu, G, law, C=None, tau_f=3.5):
     """tau_f of the fine grid (a_lu nodes per a): the given one, or lower where E_lu would pass E_MAX."""
-    u = min((tau_f - 0.5) / 3 * re / a_lu, math.sqrt(E_MAX * re * G / (a_lu * stiffness_factor(law, C))))
+    u = min(exact_lattice_velocity(re, a_lu, tau_f), math.sqrt(E_MAX * re * G / (a_lu * stiffness_factor(law, C))))
     return round(0.5 + 3 * u * a_lu / re, 4)
 
 
@@ -51,7 +56,7 @@ def stable_time_step(re, a_lu, G, law, C=None, tau_f=3.5):
     E_MAX; quick (half the resolution, where E_lu doubles at the same tau_f) multiplies the lattice velocity by 2,
     or less, until E_lu = E_MAX."""
     tau_f = stable_tau_f(re, a_lu, G, law, C, tau_f)
-    u = (tau_f - 0.5) / 3 * re / a_lu
+    u = exact_lattice_velocity(re, a_lu, tau_f)
     speedup = round(min(2.0, math.sqrt(E_MAX * re * G / (a_lu / 2 * stiffness_factor(law, C))) / u), 4)
     return {"tau_f": tau_f, "quick_speedup": speedup}
 
