@@ -4,7 +4,10 @@
 // Layout. The coarse grid covers the whole domain. The fine block's ghost ring is the line
 // (surface) MN of thesis fig. 2.2 and lies on coarse nodes; coarse nodes strictly inside MN
 // are "covered" and their values come from the coincident fine nodes, so the innermost
-// uncovered ring (AB) of the thesis is fed by the fine solution.
+// uncovered ring (AB) of the thesis is fed by the fine solution. Only the outermost covered
+// layer streams into uncovered nodes, so only it is restricted every step; the covered nodes
+// inside it evolve as a coarse solution that nothing reads (outputs read the fine nodes
+// through them, fine_node_under).
 //
 // Transfers (pre-collision populations, so τ = 1 is not singular, unlike eq. 2.11/2.12):
 //   fine from coarse:  f_f = f_eq + τ_f/(m τ_c) · (f_c − f_eq)
@@ -24,7 +27,9 @@
 // unchanged to round-off (tests/verification).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <vector>
 
@@ -58,6 +63,10 @@ class TwoLevel {
     build_restriction();
     history_.assign(3 * sources_.size() * Q, T(0));
     at_s_.assign(sources_.size() * Q, T(0));
+    // Whole batches: the last one is filled with ghosts that have no weight (f = 0, the rest
+    // state) and no link.
+    while (ghosts_.size() % batch != 0)
+      ghosts_.push_back({static_cast<int>(weights_.size()), 0, static_cast<int>(links_.size()), 0});
   }
 
   /// Records the coarse populations needed by the fine ghosts at the new coarse time level.
@@ -82,56 +91,64 @@ class TwoLevel {
     T* next = fine.next();
     const std::ptrdiff_t N = fine.grid().size();
     const std::size_t S = sources_.size();
-    // In time first, once per source (a source serves up to 16 ghosts), then in space.
-    T* at_s = at_s_.data();
+    // In time first, once per source (a source serves up to 16 ghosts), then in space. At
+    // s = 0 the formula gives the level t_n itself.
+    const T* at_s = &history_[lev[1] * S * Q];
+    if (s != 0.0) {
+      T* out = at_s_.data();
 #pragma omp parallel for schedule(static)
-    for (std::size_t src = 0; src < S; ++src) {
-      const T* h0 = &history_[(lev[0] * S + src) * Q];
-      const T* h1 = &history_[(lev[1] * S + src) * Q];
-      const T* h2 = &history_[(lev[2] * S + src) * Q];
-      for (int i = 0; i < Q; ++i) at_s[src * Q + i] = T(lag[0]) * h0[i] + T(lag[1]) * h1[i] + T(lag[2]) * h2[i];
+      for (std::size_t src = 0; src < S; ++src) {
+        const T* h0 = &history_[(lev[0] * S + src) * Q];
+        const T* h1 = &history_[(lev[1] * S + src) * Q];
+        const T* h2 = &history_[(lev[2] * S + src) * Q];
+        for (int i = 0; i < Q; ++i) out[src * Q + i] = T(lag[0]) * h0[i] + T(lag[1]) * h1[i] + T(lag[2]) * h2[i];
+      }
+      at_s = out;
     }
-    const std::size_t G = ghosts_.size();
+    // Then, per batch of ghosts, in space (into a small structure of arrays) and the collision
+    // vectorised over the batch (as the far field, boundary/boundary_set.hpp).
+    const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(ghosts_.size()) / batch;
 #pragma omp parallel for schedule(static)
-    for (std::size_t k = 0; k < G; ++k) {
-      const auto& gh = ghosts_[k];
-      // The links scatter over the 19 population planes, mostly one cache line each: ask for
-      // the lines of a ghost a few ahead now, so that the writes do not wait on them in turn.
-      if (k + kPrefetchAhead < G) {
-        const auto& ahead = ghosts_[k + kPrefetchAhead];
-        for (int l = ahead.first_link; l < ahead.first_link + ahead.link_count; ++l)
-          __builtin_prefetch(&next[links_[l].i * N + links_[l].dst], 1);
+    for (std::ptrdiff_t bt = 0; bt < batches; ++bt) {
+      T coarse_f[Q][batch];
+      for (int b = 0; b < batch; ++b) {
+        const auto& gh = ghosts_[bt * batch + b];
+        T f[Q] = {};
+        for (int w = gh.first_weight; w < gh.first_weight + gh.weight_count; ++w) {
+          const auto& sw = weights_[w];
+          const T* h = &at_s[sw.source * Q];
+          const T c = T(sw.weight);
+          for (int i = 0; i < Q; ++i) f[i] += c * h[i];
+        }
+        for (int i = 0; i < Q; ++i) coarse_f[i][b] = f[i];
       }
-      T f[Q] = {};
-      for (int w = gh.first_weight; w < gh.first_weight + gh.weight_count; ++w) {
-        const auto& sw = weights_[w];
-        const T* h = &at_s[sw.source * Q];
-        const T c = T(sw.weight);
-        for (int i = 0; i < Q; ++i) f[i] += c * h[i];
-      }
-      T feq[Q], post[Q];
-      const auto mo = collision::moments<L, T>(f);
-      collision::equilibrium<L, T>(mo.rho, mo.u, feq);
-      rescale_non_equilibrium(f, feq, f_from_c_, f);
-      op_fine.template collide<L, T>(f, feq, post);
-      for (int l = gh.first_link; l < gh.first_link + gh.link_count; ++l)
-        next[links_[l].i * N + links_[l].dst] = post[links_[l].i];
+      collide_ghosts(coarse_f, next, N, op_fine, bt * batch);
     }
   }
 
-  /// Sets the covered coarse nodes (current buffer) from the coincident fine nodes.
+  /// Sets the covered coarse nodes that stream into uncovered ones (the outermost covered
+  /// layer) from the coincident fine nodes, in the current buffer. Deeper covered nodes reach
+  /// nothing outside the fine block before they are overwritten, so they are left to evolve on
+  /// their own; `restrict_everywhere` sets them too, and `fine_node_under` reads through them.
   void restrict_to_coarse(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine) const {
-#pragma omp parallel for schedule(static)
-    for (std::size_t k = 0; k < restrict_.size(); ++k) {
-      const auto [c, f_node] = restrict_[k];
-      T f[Q], feq[Q];
-      for (int i = 0; i < Q; ++i) f[i] = fine(i, f_node);
-      const auto mo = collision::moments<L, T>(f);
-      collision::equilibrium<L, T>(mo.rho, mo.u, feq);
-      T out[Q];
-      rescale_non_equilibrium(f, feq, c_from_f_, out);
-      for (int i = 0; i < Q; ++i) coarse(i, c) = out[i];
-    }
+    restrict_nodes(coarse, fine, band_);
+  }
+
+  /// Sets every covered coarse node from the fine block (the initial state).
+  void restrict_everywhere(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine) const {
+    NodePairs all;
+    field::for_each_interior<D>(coarse_, [&](const Index<D>& c) {
+      if (covered(c)) all.push_back(coarse_.index(c), fine_node_under(c));
+    });
+    all.pad();
+    restrict_nodes(coarse, fine, all);
+  }
+
+  /// The fine node that coincides with the covered coarse node c.
+  std::ptrdiff_t fine_node_under(const Index<D>& c) const {
+    Index<D> f;
+    for (int a = 0; a < D; ++a) f[a] = 2 * (c[a] - cov_lo_[a]) - 1;
+    return fine_.index(f);
   }
 
   /// The coarse history the ghosts interpolate in time (io/checkpoint.hpp archive).
@@ -142,8 +159,6 @@ class TwoLevel {
     ar(prefix + "primed", primed_);
   }
 
-  /// Number of fine ghost nodes (surface size of the coupling).
-  std::size_t ghost_count() const { return ghosts_.size(); }
   /// Whether a coarse node lies strictly inside the fine block (its value comes from the fine grid).
   bool covered(const Index<D>& c) const {
     for (int a = 0; a < D; ++a)
@@ -152,7 +167,33 @@ class TwoLevel {
   }
 
  private:
-  static constexpr std::size_t kPrefetchAhead = 4;  // ghosts (fill_fine_ghosts)
+  /// Ghosts per vector loop of collide_ghosts: one 64-byte cache line of T.
+  static constexpr int batch = static_cast<int>(64 / sizeof(T));
+
+  /// Ghosts k0 … k0 + batch − 1 from their interpolated coarse populations: rescaled to the
+  /// fine block, collided with the fine operator, then pushed along their links.
+  template <class Op>
+  void collide_ghosts(const T (&coarse_f)[Q][batch], T* __restrict next, std::ptrdiff_t N, const Op& op,
+                      std::ptrdiff_t k0) const {
+    T post[Q][batch];
+#pragma omp simd
+    for (int b = 0; b < batch; ++b) {
+      T f[Q], feq[Q], out[Q], rho, u[D];
+#pragma GCC unroll 19
+      for (int i = 0; i < Q; ++i) f[i] = coarse_f[i][b];
+      collision::moments<L, T>(f, rho, u);
+      collision::equilibrium<L, T>(rho, u, feq);
+      rescale_non_equilibrium(f, feq, f_from_c_, f);
+      op.template collide<L, T>(f, feq, out);
+#pragma GCC unroll 19
+      for (int i = 0; i < Q; ++i) post[i][b] = out[i];
+    }
+    for (int b = 0; b < batch; ++b) {
+      const auto& gh = ghosts_[k0 + b];
+      for (int l = gh.first_link; l < gh.first_link + gh.link_count; ++l)
+        next[links_[l].i * N + links_[l].dst] = post[links_[l].i][b];
+    }
+  }
 
   struct Weight {
     std::size_t source;  // index into sources_
@@ -165,11 +206,28 @@ class TwoLevel {
     int i;
     std::ptrdiff_t dst;
   };
+  /// Coincident coarse and fine nodes, in whole batches (the last pair repeated: rewriting a
+  /// node with the same value is harmless).
+  struct NodePairs {
+    std::vector<int> coarse, fine;
+    void push_back(std::ptrdiff_t c, std::ptrdiff_t f) {
+      CAPLAB_CHECK(std::max(c, f) <= std::numeric_limits<int>::max(), "block too large for 32-bit node indices");
+      coarse.push_back(static_cast<int>(c));
+      fine.push_back(static_cast<int>(f));
+    }
+    void pad() {
+      while (!coarse.empty() && coarse.size() % batch != 0) push_back(coarse.back(), fine.back());
+    }
+  };
 
   /// out = f_eq + s+ · (even part of f_neq) + s− · (odd part of f_neq); out may alias f.
   static void rescale_non_equilibrium(const T (&f)[Q], const T (&feq)[Q], const Taus& s, T (&out)[Q]) {
+    // Unrolled: inside collide_ghosts' `omp simd` loop an inner loop stops GCC from
+    // vectorising over the ghosts.
     T neq[Q];
+#pragma GCC unroll 19
     for (int i = 0; i < Q; ++i) neq[i] = f[i] - feq[i];
+#pragma GCC unroll 19
     for (int i = 0; i < Q; ++i) {
       const int o = L::opposite[i];
       out[i] = feq[i] + T(0.5 * s.plus) * (neq[i] + neq[o]) + T(0.5 * s.minus) * (neq[i] - neq[o]);
@@ -232,26 +290,51 @@ class TwoLevel {
   }
 
   void build_restriction() {
-    // Covered coarse nodes: strictly between the coarse indices of the ghost ring.
+    // Covered coarse nodes: strictly between the coarse indices of the ghost ring (which lies
+    // half a fine spacing outside the first fine node, fine index -1).
     Index<D> lo_f, hi_f;
-    for (int a = 0; a < D; ++a) lo_f[a] = -1, hi_f[a] = -1;
-    const Index<D> lo2 = doubled_coarse_coordinate(lo_f);
-    for (int a = 0; a < D; ++a) hi_f[a] = fine_.n()[a];
-    Index<D> tmp = lo_f;
-    for (int a = 0; a < D; ++a) tmp[a] = hi_f[a];
-    const Index<D> hi2 = doubled_coarse_coordinate(tmp);
+    for (int a = 0; a < D; ++a) lo_f[a] = -1, hi_f[a] = fine_.n()[a];
+    const Index<D> lo2 = doubled_coarse_coordinate(lo_f), hi2 = doubled_coarse_coordinate(hi_f);
     for (int a = 0; a < D; ++a) {
       cov_lo_[a] = lo2[a] / 2;
       cov_hi_[a] = hi2[a] / 2;
     }
-    field::for_each_interior<D>(fine_, [&](const Index<D>& f) {
-      const Index<D> k2 = doubled_coarse_coordinate(f);
-      for (int a = 0; a < D; ++a)
-        if (k2[a] % 2 != 0) return;
-      Index<D> c;
-      for (int a = 0; a < D; ++a) c[a] = k2[a] / 2;
-      restrict_.push_back({coarse_.index(c), fine_.index(f)});
+    // The band: covered nodes one link (max norm) from an uncovered node.
+    field::for_each_interior<D>(coarse_, [&](const Index<D>& c) {
+      if (!covered(c)) return;
+      bool outermost = false;
+      for (int a = 0; a < D; ++a) outermost = outermost || c[a] == cov_lo_[a] + 1 || c[a] == cov_hi_[a] - 1;
+      if (outermost) band_.push_back(coarse_.index(c), fine_node_under(c));
     });
+    band_.pad();
+  }
+
+  /// Coarse nodes from their coincident fine nodes, vectorised over batches of nodes.
+  void restrict_nodes(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine,
+                      const NodePairs& nodes) const {
+    const T* __restrict src = fine.current();
+    T* __restrict dst = coarse.current();
+    const std::ptrdiff_t Nf = fine.grid().size(), Nc = coarse.grid().size();
+    const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(nodes.coarse.size()) / batch;
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t bt = 0; bt < batches; ++bt) {
+      const std::ptrdiff_t k0 = bt * batch;
+      T out[Q][batch];
+#pragma omp simd
+      for (int b = 0; b < batch; ++b) {
+        T f[Q], feq[Q], rho, u[D];
+        // 32-bit node indices into each population's array: a vector gather (as the far field).
+#pragma GCC unroll 19
+        for (int i = 0; i < Q; ++i) f[i] = (src + i * Nf)[nodes.fine[k0 + b]];
+        collision::moments<L, T>(f, rho, u);
+        collision::equilibrium<L, T>(rho, u, feq);
+        rescale_non_equilibrium(f, feq, c_from_f_, f);
+#pragma GCC unroll 19
+        for (int i = 0; i < Q; ++i) out[i][b] = f[i];
+      }
+      for (int b = 0; b < batch; ++b)
+        for (int i = 0; i < Q; ++i) dst[i * Nc + nodes.coarse[k0 + b]] = out[i][b];
+    }
   }
 
   void store_level(const field::Populations<L, T>& coarse, int level) {
@@ -266,7 +349,7 @@ class TwoLevel {
   std::vector<Weight> weights_;
   std::vector<Ghost> ghosts_;
   std::vector<Link> links_;
-  std::vector<std::pair<std::ptrdiff_t, std::ptrdiff_t>> restrict_;  // (coarse node, fine node)
+  NodePairs band_;  // restricted every step
   std::vector<T> history_;  // [level][source][i]
   std::vector<T> at_s_;     // [source][i]: the history interpolated to the substep being filled
   Index<D> cov_lo_{}, cov_hi_{};

@@ -83,7 +83,7 @@ class Fluid {
       collision::initialise_equilibrium(blk.pop, [&](const Index<D>& ijk) { return init(g.position(ijk)); });
     }
     if (two_level()) {
-      coupling_.restrict_to_coarse(blocks_[0].pop, blocks_[1].pop);
+      coupling_.restrict_everywhere(blocks_[0].pop, blocks_[1].pop);
       coupling_.capture_coarse(blocks_[0].pop);
     }
   }

@@ -827,9 +827,14 @@ class Scene {
       std::vector<double> rho(N, 1.0);
       std::array<std::vector<double>, D> u;
       for (auto& c : u) c.assign(N, 0.0);
+      // Coarse nodes under the fine block show the fine node they coincide with (the value the
+      // restriction would give them: it keeps ρ and u).
+      const bool under_fine = b == 0 && fluid_.two_level();
       field::for_each_interior<D>(grid, [&](const Index<D>& ijk) {
         const auto n = grid.index(ijk);
-        const auto m = collision::node_moments<L, T>(blk.pop, n);
+        const auto m = under_fine && fluid_.coupling().covered(ijk)
+                           ? collision::node_moments<L, T>(fluid_.finest().pop, fluid_.coupling().fine_node_under(ijk))
+                           : collision::node_moments<L, T>(blk.pop, n);
         rho[n] = m.rho;
         for (int a = 0; a < D; ++a) u[a][n] = m.u[a] / units_.velocity_lu;  // in U
       });
