@@ -3,11 +3,11 @@
 //
 // Layout. The coarse grid covers the whole domain. The fine block's ghost ring is the line
 // (surface) MN of thesis fig. 2.2 and lies on coarse nodes; coarse nodes strictly inside MN
-// are "covered" and their values come from the coincident fine nodes, so the innermost
-// uncovered ring (AB) of the thesis is fed by the fine solution. Only the outermost covered
-// layer streams into uncovered nodes, so only it is restricted every step; the covered nodes
-// inside it evolve as a coarse solution that nothing reads (outputs read the fine nodes
-// through them, fine_node_under).
+// are "covered": the fine solution stands for them, so the innermost uncovered ring (AB) of
+// the thesis is fed by the fine solution. Only the outermost covered layer streams into
+// uncovered nodes, so only it is restricted from the coincident fine nodes every step; the
+// covered nodes inside it evolve as a coarse solution that nothing reads (outputs read the
+// fine nodes through them, fine_node_under).
 //
 // Transfers (pre-collision populations, so τ = 1 is not singular, unlike eq. 2.11/2.12):
 //   fine from coarse:  f_f = f_eq + τ_f/(m τ_c) · (f_c − f_eq)
@@ -136,12 +136,7 @@ class TwoLevel {
 
   /// Sets every covered coarse node from the fine block (the initial state).
   void restrict_everywhere(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine) const {
-    NodePairs all;
-    field::for_each_interior<D>(coarse_, [&](const Index<D>& c) {
-      if (covered(c)) all.push_back(coarse_.index(c), fine_node_under(c));
-    });
-    all.pad();
-    restrict_nodes(coarse, fine, all);
+    restrict_nodes(coarse, fine, covered_pairs(false));
   }
 
   /// The fine node that coincides with the covered coarse node c.
@@ -159,7 +154,7 @@ class TwoLevel {
     ar(prefix + "primed", primed_);
   }
 
-  /// Whether a coarse node lies strictly inside the fine block (its value comes from the fine grid).
+  /// Whether a coarse node lies strictly inside the fine block (it is read through the fine grid).
   bool covered(const Index<D>& c) const {
     for (int a = 0; a < D; ++a)
       if (c[a] <= cov_lo_[a] || c[a] >= cov_hi_[a]) return false;
@@ -167,7 +162,7 @@ class TwoLevel {
   }
 
  private:
-  /// Ghosts per vector loop of collide_ghosts: one 64-byte cache line of T.
+  /// Nodes per vector loop (collide_ghosts, restrict_nodes): one 64-byte cache line of T.
   static constexpr int batch = static_cast<int>(64 / sizeof(T));
 
   /// Ghosts k0 … k0 + batch − 1 from their interpolated coarse populations: rescaled to the
@@ -222,8 +217,8 @@ class TwoLevel {
 
   /// out = f_eq + s+ · (even part of f_neq) + s− · (odd part of f_neq); out may alias f.
   static void rescale_non_equilibrium(const T (&f)[Q], const T (&feq)[Q], const Taus& s, T (&out)[Q]) {
-    // Unrolled: inside collide_ghosts' `omp simd` loop an inner loop stops GCC from
-    // vectorising over the ghosts.
+    // Unrolled: inside the `omp simd` loops of collide_ghosts and restrict_nodes an inner loop
+    // stops GCC from vectorising over the nodes.
     T neq[Q];
 #pragma GCC unroll 19
     for (int i = 0; i < Q; ++i) neq[i] = f[i] - feq[i];
@@ -296,17 +291,26 @@ class TwoLevel {
     for (int a = 0; a < D; ++a) lo_f[a] = -1, hi_f[a] = fine_.n()[a];
     const Index<D> lo2 = doubled_coarse_coordinate(lo_f), hi2 = doubled_coarse_coordinate(hi_f);
     for (int a = 0; a < D; ++a) {
+      CAPLAB_CHECK(lo2[a] % 2 == 0 && hi2[a] % 2 == 0,
+                   "the fine block's ghost ring must lie on coarse nodes (an odd number of fine nodes per axis)");
       cov_lo_[a] = lo2[a] / 2;
       cov_hi_[a] = hi2[a] / 2;
     }
-    // The band: covered nodes one link (max norm) from an uncovered node.
+    band_ = covered_pairs(true);
+  }
+
+  /// Covered coarse nodes and their fine nodes: all, or only the band (one link, max norm,
+  /// from an uncovered node).
+  NodePairs covered_pairs(bool band_only) const {
+    NodePairs pairs;
     field::for_each_interior<D>(coarse_, [&](const Index<D>& c) {
       if (!covered(c)) return;
       bool outermost = false;
       for (int a = 0; a < D; ++a) outermost = outermost || c[a] == cov_lo_[a] + 1 || c[a] == cov_hi_[a] - 1;
-      if (outermost) band_.push_back(coarse_.index(c), fine_node_under(c));
+      if (outermost || !band_only) pairs.push_back(coarse_.index(c), fine_node_under(c));
     });
-    band_.pad();
+    pairs.pad();
+    return pairs;
   }
 
   /// Coarse nodes from their coincident fine nodes, vectorised over batches of nodes.
@@ -351,7 +355,7 @@ class TwoLevel {
   std::vector<Link> links_;
   NodePairs band_;  // restricted every step
   std::vector<T> history_;  // [level][source][i]
-  std::vector<T> at_s_;     // [source][i]: the history interpolated to the substep being filled
+  std::vector<T> at_s_;     // [source][i]: the history interpolated to the substep (s > 0) being filled
   Index<D> cov_lo_{}, cov_hi_{};
   int newest_ = 0;
   bool primed_ = false;

@@ -765,7 +765,8 @@ class Scene {
       std::string problem;
       Index<D> where{};
       field::for_each_interior<D>(grid, [&](const Index<D>& ijk) {
-        // Coarse nodes under the fine block only mirror it (restriction): the fine node is checked.
+        // Coarse nodes under the fine block are restricted from it (outermost layer) or evolve
+        // unread (deeper): the fine node is checked.
         if (!problem.empty() || (b == 0 && fluid_.two_level() && fluid_.coupling().covered(ijk))) return;
         const auto m = collision::node_moments<L, T>(blk.pop, grid.index(ijk));
         double u2 = 0;
