@@ -14,8 +14,10 @@ Output: ``OUT/index.html`` (+ ``index.pdf`` printed by headless Chromium), self-
 Definitions used on the page:
   roofline_mlups   copy bandwidth / bytes per update (bench.json "roofline"); fraction = MLUPS / roofline;
   two-level overhead   uniform MLUPS / two-level MLUPS - 1 at the same lattice, collision, precision and
-                   threads (bench.json "overhead_vs_uniform"): the extra time per node update that the
-                   block coupling costs;
+                   threads (bench.json "overhead_vs_uniform"), the uniform box of the same coarse size
+                   timed in batches alternating with the two-level ones ("uniform_twin_mlups"), the
+                   median over batch pairs: the extra time per node update that the block coupling
+                   costs;
   stage shares     manifest "stage_share": fluid (the update without the parts below), coupling (the
                    two-level grid coupling: ghost fill, restriction), ib (interpolation, spreading, forced
                    collision), membrane (forces, node motion), diagnostics, output. "IB + membrane" is the

@@ -7,8 +7,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <utility>
+#include <vector>
 
 #include "core/error.hpp"
 #include "lattice/lattice.hpp"
@@ -47,19 +49,16 @@ constexpr const char* precision_name() {
   return sizeof(T) == 8 ? "double" : "float";
 }
 
+/// The periodic box of case c, with the centred fine block when `two_level`.
 template <class L, class T, class Op>
-FluidMeasurement measure(const FluidCase& c, double min_seconds) {
+std::unique_ptr<sim::Fluid<L, T, Op>> make_fluid(const FluidCase& c, bool two_level, FluidMeasurement& r) {
   constexpr int D = L::d;
   using FluidT = sim::Fluid<L, T, Op>;
-  ThreadScope scope(c.threads);
-
   typename FluidT::Setup s;
   Index<D> n;
   n.fill(c.n);
   s.coarse = field::Grid<D>(n, Vec<D>::Zero(), 1.0);
-  FluidMeasurement r;
-  r.size.assign(D, c.n);
-  if (c.two_level) {
+  if (two_level) {
     // Centred block of `side` coarse cells per axis, side^D ≈ n^D / 8. Its ghost ring lies on
     // coarse nodes lo and hi (the layout of refinement/two_level.hpp).
     const int side = std::max(2, static_cast<int>(std::lround(c.n * std::pow(0.125, 1.0 / D))));
@@ -75,44 +74,22 @@ FluidMeasurement measure(const FluidCase& c, double min_seconds) {
   s.imposed_velocity_lu = [](const Vec<D>&) { return Vec<D>::Zero(); };
   s.coarse_op.tau = 0.8;
 
-  FluidT fluid(s);
+  auto fluid = std::make_unique<FluidT>(s);
   const double k = 2 * std::numbers::pi / c.n;
-  fluid.initialise([&](const Vec<D>& x) {
+  fluid->initialise([&](const Vec<D>& x) {
     Vec<D> u = Vec<D>::Constant(0.02);
     u[0] = 0.05;
     u[0] += 0.01 * std::sin(k * x[0]) * std::cos(k * x[1]);
     u[1] -= 0.01 * std::cos(k * x[0]) * std::sin(k * x[1]);
     return std::pair<double, Vec<D>>(1.0, u);
   });
+  return fluid;
+}
 
-  fluid.step();  // warm-up (first touch of the next buffer happens here)
-  double t0 = now_seconds();
-  fluid.step();
-  const double t_step = std::max(now_seconds() - t0, 1e-9);
-  const long batch = std::max(1L, static_cast<long>(std::ceil(min_seconds / 5 / t_step)));
-
-  const double coupling0 = fluid.coupling_seconds();
-  const double cpu0 = process_cpu_seconds();
-  double elapsed = 0;
-  int batches = 0;
-  while (elapsed < min_seconds || batches < 3) {
-    t0 = now_seconds();
-    for (long i = 0; i < batch; ++i) fluid.step();
-    const double t = now_seconds() - t0;
-    elapsed += t;
-    ++batches;
-    r.mlups_best = std::max(r.mlups_best, batch * fluid.updates_per_step() / t * 1e-6);
-  }
-  r.updates_per_step = fluid.updates_per_step();
-  r.steps = batch * batches;
-  r.seconds = elapsed;
-  r.mlups = r.steps * r.updates_per_step / elapsed * 1e-6;
-  r.coupling_seconds = fluid.coupling_seconds() - coupling0;
-  r.cpu_share = (process_cpu_seconds() - cpu0) / (c.threads * elapsed);
-  r.bytes_per_update = field::Populations<L, T>::bytes_per_update();
-  r.bytes_per_update_write_allocate = 3 * L::q * sizeof(T);
-
-  // Sanity, separate from speed: a benchmark of a broken flow is not a result.
+/// Sanity, separate from speed: a benchmark of a broken flow is not a result.
+template <class Fluid>
+void check_flow(const Fluid& fluid) {
+  constexpr int D = Fluid::D;
   for (std::size_t b = 0; b < fluid.block_count(); ++b) {
     const auto& pop = fluid.block(b).pop;
     Index<D> probe;
@@ -123,6 +100,70 @@ FluidMeasurement measure(const FluidCase& c, double min_seconds) {
     CAPLAB_CHECK(std::isfinite(static_cast<double>(m.rho)) && std::abs(m.rho - 1.0) < 0.1,
                  "bench: the benchmark flow is not finite or drifted; the measurement is void");
   }
+}
+
+/// Batch length (steps) for about 1/5 of the minimum time, after one warm-up step (the first
+/// touch of the next buffer happens there) and one timed step.
+template <class Fluid>
+long batch_steps(Fluid& fluid, double min_seconds) {
+  fluid.step();
+  const double t0 = now_seconds();
+  fluid.step();
+  const double t_step = std::max(now_seconds() - t0, 1e-9);
+  return std::max(1L, static_cast<long>(std::ceil(min_seconds / 5 / t_step)));
+}
+
+template <class L, class T, class Op>
+FluidMeasurement measure(const FluidCase& c, double min_seconds) {
+  ThreadScope scope(c.threads);
+  FluidMeasurement r;
+  r.size.assign(L::d, c.n);
+  auto fluid = make_fluid<L, T, Op>(c, c.two_level, r);
+  // Two-level: the uniform box of the same coarse size runs in the batches between, and the
+  // overhead is the median over batch pairs of the ratio of their speeds: measurements taken
+  // at the same moments, a slow batch on either side rejected (the machine's speed drifts
+  // between separate measurements and jumps within seconds).
+  FluidMeasurement unused;
+  auto twin = c.two_level ? make_fluid<L, T, Op>(c, false, unused) : nullptr;
+  const long batch = batch_steps(*fluid, min_seconds);
+  const long twin_batch = twin ? batch_steps(*twin, min_seconds) : 0;
+
+  const double coupling0 = fluid->coupling_seconds();
+  const double cpu0 = process_cpu_seconds();
+  double elapsed = 0, twin_elapsed = 0;
+  int batches = 0;
+  std::vector<double> ratios;  // per batch pair: uniform twin MLUPS / two-level MLUPS
+  while (elapsed < min_seconds || batches < 3) {
+    double t0 = now_seconds();
+    for (long i = 0; i < batch; ++i) fluid->step();
+    const double t = now_seconds() - t0;
+    elapsed += t;
+    ++batches;
+    r.mlups_best = std::max(r.mlups_best, batch * fluid->updates_per_step() / t * 1e-6);
+    if (twin) {
+      t0 = now_seconds();
+      for (long i = 0; i < twin_batch; ++i) twin->step();
+      const double tt = now_seconds() - t0;
+      twin_elapsed += tt;
+      ratios.push_back((twin_batch * twin->updates_per_step() / tt) / (batch * fluid->updates_per_step() / t));
+    }
+  }
+  r.updates_per_step = fluid->updates_per_step();
+  r.steps = batch * batches;
+  r.seconds = elapsed;
+  r.mlups = r.steps * r.updates_per_step / elapsed * 1e-6;
+  r.coupling_seconds = fluid->coupling_seconds() - coupling0;
+  r.cpu_share = (process_cpu_seconds() - cpu0) / (c.threads * (elapsed + twin_elapsed));
+  if (twin) {
+    r.uniform_twin_mlups = twin_batch * batches * twin->updates_per_step() / twin_elapsed * 1e-6;
+    std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+    r.overhead = ratios[ratios.size() / 2] - 1.0;
+  }
+  r.bytes_per_update = field::Populations<L, T>::bytes_per_update();
+  r.bytes_per_update_write_allocate = 3 * L::q * sizeof(T);
+
+  check_flow(*fluid);
+  if (twin) check_flow(*twin);
   return r;
 }
 

@@ -7,8 +7,10 @@
 // volume; one step is one coarse step, two fine substeps and the coupling, and counts
 // coarse + 2 × fine interior nodes (Fluid::updates_per_step).
 // Timing: one warm-up step, then batches of steps (each about 1/5 of the minimum time) until
-// the minimum time has passed and at least three batches ran. The process CPU time over the
-// window tells whether the threads had the cores to themselves (cpu_share).
+// the minimum time has passed and at least three batches ran; a two-level case alternates its
+// batches with those of its uniform twin (same coarse box), and its overhead is the median of
+// the per-pair speed ratios. The process CPU time over the window tells whether the threads
+// had the cores to themselves (cpu_share).
 #pragma once
 
 #include <array>
@@ -37,6 +39,11 @@ struct FluidMeasurement {
   double mlups = 0;             // steps × updates / seconds over the window
   double mlups_best = 0;        // best batch
   double coupling_seconds = 0;  // two-level coupling time inside the window
+  /// Two-level: MLUPS of the uniform box of the same coarse size, timed in batches alternating
+  /// with the two-level ones (a same-moment reference for the overhead).
+  double uniform_twin_mlups = 0;
+  /// Two-level: median over the batch pairs of uniform-twin MLUPS / two-level MLUPS, minus 1.
+  double overhead = 0;
   /// Process CPU time / (threads × wall time) over the window: well below 1 means the threads
   /// were descheduled (other work on the machine) and the timing is contended.
   double cpu_share = 0;
