@@ -3,8 +3,10 @@
 // to the returned JSON) and rejection of bad options. No timing thresholds: timings on a
 // shared machine are noise, so no test here can depend on how fast anything ran.
 #include <gtest/gtest.h>
+
 #include <unistd.h>
 
+#include <cmath>
 #include <fstream>
 #include <set>
 
@@ -81,6 +83,10 @@ TEST(Bench, QuickRunHasEveryRowAndConsistentRoofline) {
     if (r["kind"] == "two_level") {
       ++two_level;
       EXPECT_TRUE(r.contains("overhead_vs_uniform"));
+      // The overhead is against the uniform twin timed between the two-level batches.
+      EXPECT_GT(r["uniform_twin_mlups"].get<double>(), 0);
+      EXPECT_TRUE(std::isfinite(r["overhead_vs_uniform"].get<double>()));
+      EXPECT_GT(r["overhead_vs_uniform"].get<double>(), -1.0);
       EXPECT_GT(r["fine_fraction"].get<double>(), 0);
       EXPECT_LT(r["fine_fraction"].get<double>(), 0.5);
       EXPECT_GE(r["coupling_share"].get<double>(), 0);
