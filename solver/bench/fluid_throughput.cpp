@@ -51,7 +51,7 @@ constexpr const char* precision_name() {
 
 /// The periodic box of case c, with the centred fine block when `two_level`.
 template <class L, class T, class Op>
-std::unique_ptr<sim::Fluid<L, T, Op>> make_fluid(const FluidCase& c, bool two_level, FluidMeasurement& r) {
+std::unique_ptr<sim::Fluid<L, T, Op>> make_fluid(const FluidCase& c, bool two_level) {
   constexpr int D = L::d;
   using FluidT = sim::Fluid<L, T, Op>;
   typename FluidT::Setup s;
@@ -67,8 +67,6 @@ std::unique_ptr<sim::Fluid<L, T, Op>> make_fluid(const FluidCase& c, bool two_le
     Vec<D> of;
     for (int a = 0; a < D; ++a) nf[a] = 2 * side - 1, of[a] = lo + 0.5;
     s.fine = field::Grid<D>(nf, of, 0.5);
-    r.fine_size.assign(D, 2 * side - 1);
-    r.fine_fraction = std::pow(static_cast<double>(side) / c.n, D);
   }
   s.boundaries.fill(boundary::Kind::periodic);
   s.imposed_velocity_lu = [](const Vec<D>&) { return Vec<D>::Zero(); };
@@ -118,13 +116,17 @@ FluidMeasurement measure(const FluidCase& c, double min_seconds) {
   ThreadScope scope(c.threads);
   FluidMeasurement r;
   r.size.assign(L::d, c.n);
-  auto fluid = make_fluid<L, T, Op>(c, c.two_level, r);
+  auto fluid = make_fluid<L, T, Op>(c, c.two_level);
+  if (c.two_level) {
+    const auto& nf = fluid->finest().pop.grid().n();
+    r.fine_size.assign(nf.begin(), nf.end());
+    r.fine_fraction = std::pow(static_cast<double>(nf[0] + 1) / (2 * c.n), L::d);  // covered share
+  }
   // Two-level: the uniform box of the same coarse size runs in the batches between, and the
   // overhead is the median over batch pairs of the ratio of their speeds: measurements taken
   // at the same moments, a slow batch on either side rejected (the machine's speed drifts
   // between separate measurements and jumps within seconds).
-  FluidMeasurement unused;
-  auto twin = c.two_level ? make_fluid<L, T, Op>(c, false, unused) : nullptr;
+  auto twin = c.two_level ? make_fluid<L, T, Op>(c, false) : nullptr;
   const long batch = batch_steps(*fluid, min_seconds);
   const long twin_batch = twin ? batch_steps(*twin, min_seconds) : 0;
 

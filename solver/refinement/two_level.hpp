@@ -173,12 +173,10 @@ class TwoLevel {
     T post[Q][batch];
 #pragma omp simd
     for (int b = 0; b < batch; ++b) {
-      T f[Q], feq[Q], out[Q], rho, u[D];
+      T f[Q], feq[Q], out[Q];
 #pragma GCC unroll 19
       for (int i = 0; i < Q; ++i) f[i] = coarse_f[i][b];
-      collision::moments<L, T>(f, rho, u);
-      collision::equilibrium<L, T>(rho, u, feq);
-      rescale_non_equilibrium(f, feq, f_from_c_, f);
+      rescale_non_equilibrium(f, feq, f_from_c_);
       op.template collide<L, T>(f, feq, out);
 #pragma GCC unroll 19
       for (int i = 0; i < Q; ++i) post[i][b] = out[i];
@@ -215,8 +213,12 @@ class TwoLevel {
     }
   };
 
-  /// out = f_eq + s+ · (even part of f_neq) + s− · (odd part of f_neq); out may alias f.
-  static void rescale_non_equilibrium(const T (&f)[Q], const T (&feq)[Q], const Taus& s, T (&out)[Q]) {
+  /// f ← f_eq + s+ · (even part of f_neq) + s− · (odd part of f_neq), with feq the equilibrium
+  /// of f's moments (which the rescaling keeps).
+  static void rescale_non_equilibrium(T (&f)[Q], T (&feq)[Q], const Taus& s) {
+    T rho, u[D];
+    collision::moments<L, T>(f, rho, u);
+    collision::equilibrium<L, T>(rho, u, feq);
     // Unrolled: inside the `omp simd` loops of collide_ghosts and restrict_nodes an inner loop
     // stops GCC from vectorising over the nodes.
     T neq[Q];
@@ -225,7 +227,7 @@ class TwoLevel {
 #pragma GCC unroll 19
     for (int i = 0; i < Q; ++i) {
       const int o = L::opposite[i];
-      out[i] = feq[i] + T(0.5 * s.plus) * (neq[i] + neq[o]) + T(0.5 * s.minus) * (neq[i] - neq[o]);
+      f[i] = feq[i] + T(0.5 * s.plus) * (neq[i] + neq[o]) + T(0.5 * s.minus) * (neq[i] - neq[o]);
     }
   }
 
@@ -326,13 +328,11 @@ class TwoLevel {
       T out[Q][batch];
 #pragma omp simd
       for (int b = 0; b < batch; ++b) {
-        T f[Q], feq[Q], rho, u[D];
+        T f[Q], feq[Q];
         // 32-bit node indices into each population's array: a vector gather (as the far field).
 #pragma GCC unroll 19
         for (int i = 0; i < Q; ++i) f[i] = (src + i * Nf)[nodes.fine[k0 + b]];
-        collision::moments<L, T>(f, rho, u);
-        collision::equilibrium<L, T>(rho, u, feq);
-        rescale_non_equilibrium(f, feq, c_from_f_, f);
+        rescale_non_equilibrium(f, feq, c_from_f_);
 #pragma GCC unroll 19
         for (int i = 0; i < Q; ++i) out[i][b] = f[i];
       }
