@@ -18,7 +18,8 @@
 // Far-field ghosts are stored as structure of arrays in memory order and processed in
 // batches: one vector loop over a batch computes all Q post-collision values of each ghost,
 // then a scalar loop writes the links. Every entering slot has exactly one source ghost, so
-// the result does not depend on the order or the batching.
+// the result does not depend on the order or the batching. Periodic and wall copies read ghost
+// slots only and write interior slots only: they run in parallel in any order.
 #pragma once
 
 #include <functional>
@@ -60,7 +61,13 @@ class BoundarySet {
   void apply(field::Populations<L, T>& pop, const Op& op) const {
     T* next = pop.next();
     const std::ptrdiff_t N = pop.grid().size();
-    for (const auto& c : copies_) next[c.dst] = next[c.src] + T(c.add);
+    // A copy reads a ghost slot and writes an interior slot, so the copies are independent.
+    // Serial, they took 8 % of a quick biconcave step on one thread (periodic in x and y, walls
+    // in z: perf), with any other thread waiting.
+    const Copy* copies = copies_.data();
+    const std::ptrdiff_t n_copies = static_cast<std::ptrdiff_t>(copies_.size());
+#pragma omp parallel for schedule(static) if (n_copies > 4096)
+    for (std::ptrdiff_t k = 0; k < n_copies; ++k) next[copies[k].dst] = next[copies[k].src] + T(copies[k].add);
     const T* current = pop.current();
     const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(far_interior_.size()) / batch;
     if (far_field_ == FarField::equilibrium) {

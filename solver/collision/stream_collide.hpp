@@ -121,6 +121,32 @@ void stream_collide(field::Populations<L, T>& pop, const Op& op,
   });
 }
 
+/// Runs body(k) for every k in [0, count): whole chunks of W consecutive k as one `omp simd`
+/// loop each (vector code: body gathers and scatters through the node list), the chunks in
+/// parallel, then the rest as one chunk shifted back to end at count − 1, after the parallel
+/// loop. That chunk redoes indices of the last whole chunk, so body(k) must write the same
+/// values each time and nothing that another k reads. Mark a lambda body
+/// `__attribute__((always_inline))`: GCC 12 otherwise calls the forced collision's body out of
+/// line and leaves the chunk loop scalar.
+template <int W, class Body>
+[[gnu::always_inline]] inline void for_each_in_chunks(std::ptrdiff_t count, const Body& body) {
+  if (count < W) {
+    for (std::ptrdiff_t k = 0; k < count; ++k) body(k);
+    return;
+  }
+  const std::ptrdiff_t whole = count / W * W;
+#pragma omp parallel for schedule(static) if (count > 256)
+  for (std::ptrdiff_t k0 = 0; k0 < whole; k0 += W) {
+#pragma omp simd
+    for (int j = 0; j < W; ++j) body(k0 + j);
+  }
+  if (whole < count) {
+    const std::ptrdiff_t last = count - W;
+#pragma omp simd
+    for (int j = 0; j < W; ++j) body(last + j);
+  }
+}
+
 /// Redoes the collide-and-push of the interior nodes `nodes` (distinct linear indices) with Guo forcing, after stream_collide<false> of the whole block: every slot of
 /// next() receives from exactly one node, so overwriting the pushes of the forced nodes gives
 /// the forced step there and the unforced one (force zero) elsewhere. This keeps the forced
@@ -128,7 +154,7 @@ void stream_collide(field::Populations<L, T>& pop, const Op& op,
 template <class L, class T, class Op>
 void collide_forced_at(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>& force,
                        std::span<const std::ptrdiff_t> nodes) {
-  constexpr int Q = L::q, D = L::d, W = simd_chunk<T>;
+  constexpr int Q = L::q, D = L::d;
   const auto& g = pop.grid();
   const std::ptrdiff_t N = g.size();
   std::ptrdiff_t off[Q];
@@ -138,26 +164,35 @@ void collide_forced_at(field::Populations<L, T>& pop, const Op& op, const field:
   const double* fp[D];
   for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data();
   const std::ptrdiff_t* node = nodes.data();
-  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(nodes.size());
-  if (count < W) {
-    for (std::ptrdiff_t k = 0; k < count; ++k) update_node<true, L, T>(src, dst, N, off, op, fp, node[k]);
-    return;
-  }
-  // Whole chunks of W nodes as vector code in parallel (gathers and scatters; the nodes are
-  // distinct, so no two lanes write one slot), then the rest as one chunk shifted back to end
-  // at the last node, after the parallel loop: it redoes nodes of the last whole chunk, which
-  // must not run on another thread at the same time.
-  const std::ptrdiff_t whole = count / W * W;
-#pragma omp parallel for schedule(static) if (count > 256)
-  for (std::ptrdiff_t k0 = 0; k0 < whole; k0 += W) {
-#pragma omp simd
-    for (int j = 0; j < W; ++j) update_node<true, L, T>(src, dst, N, off, op, fp, node[k0 + j]);
-  }
-  if (whole < count) {
-    const std::ptrdiff_t* tail = node + (count - W);
-#pragma omp simd
-    for (int j = 0; j < W; ++j) update_node<true, L, T>(src, dst, N, off, op, fp, tail[j]);
-  }
+  // The nodes are distinct, so no two lanes write one slot.
+  auto body = [=](std::ptrdiff_t k) __attribute__((always_inline)) {
+    update_node<true, L, T>(src, dst, N, off, op, fp, node[k]);
+  };
+  for_each_in_chunks<simd_chunk<T>>(static_cast<std::ptrdiff_t>(nodes.size()), body);
+}
+
+/// u + F/(2ρ) at the distinct interior nodes `nodes` into `u` (same linear indices): the
+/// velocity of the forced collision (thesis eq. 2.25), which the markers move with. In double,
+/// as node_moments; vector code over the node list as collide_forced_at.
+template <class L, class T>
+void forced_velocity_at(const field::Populations<L, T>& pop, const field::VectorField<L::d, double>& force,
+                        std::span<const std::ptrdiff_t> nodes, field::VectorField<L::d, double>& u) {
+  constexpr int Q = L::q, D = L::d;
+  const std::ptrdiff_t N = pop.grid().size();
+  const T* src = pop.current();
+  const double* fp[D];
+  double* up[D];
+  for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data(), up[a] = u.comp[a].data();
+  const std::ptrdiff_t* node = nodes.data();
+  auto body = [=](std::ptrdiff_t k) __attribute__((always_inline)) {
+    const std::ptrdiff_t n = node[k];
+    double f[Q], rho, v[D];
+#pragma GCC unroll 19
+    for (int i = 0; i < Q; ++i) f[i] = src[i * N + n];
+    moments<L, double>(f, rho, v);
+    for (int a = 0; a < D; ++a) up[a][n] = v[a] + fp[a][n] / (2.0 * rho);
+  };
+  for_each_in_chunks<simd_chunk<T>>(static_cast<std::ptrdiff_t>(nodes.size()), body);
 }
 
 /// Sets every interior node to the equilibrium of (ρ, u(x)) given by init(Index) -> (ρ, Vec).

@@ -500,13 +500,7 @@ class Scene {
       // interpolation reads), so that the interpolation reads rows of consecutive nodes.
       if (static_cast<std::ptrdiff_t>(forced_velocity_.comp[0].size()) != pop.grid().size())
         forced_velocity_ = field::VectorField<D>(pop.grid().size());
-      const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(forced_nodes_.size());
-#pragma omp parallel for schedule(static) if (count > 256)
-      for (std::ptrdiff_t k = 0; k < count; ++k) {
-        const std::ptrdiff_t n = forced_nodes_[k];
-        const auto m = collision::node_moments<L, T>(pop, n);
-        for (int a = 0; a < D; ++a) forced_velocity_.comp[a][n] = m.u[a] + f.comp[a][n] / (2.0 * m.rho);
-      }
+      collision::forced_velocity_at<L, T>(pop, f, forced_nodes_, forced_velocity_);
       for (auto& c : capsules_) c.advect(forced_velocity_, pop.grid().dx());
     });
   }
