@@ -62,12 +62,13 @@ class BoundarySet {
     T* next = pop.next();
     const std::ptrdiff_t N = pop.grid().size();
     // A copy reads a ghost slot and writes an interior slot, so the copies are independent.
-    // Serial, they took 8 % of a quick biconcave step on one thread (periodic in x and y, walls
-    // in z: perf), with any other thread waiting.
+    // Serial, they took 8 % of a quick biconcave step on one thread (perf; periodic in x and y,
+    // walls in z), with any other thread waiting.
     const Copy* copies = copies_.data();
     const std::ptrdiff_t n_copies = static_cast<std::ptrdiff_t>(copies_.size());
 #pragma omp parallel for schedule(static) if (n_copies > 4096)
-    for (std::ptrdiff_t k = 0; k < n_copies; ++k) next[copies[k].dst] = next[copies[k].src] + T(copies[k].add);
+    for (std::ptrdiff_t k = 0; k < n_copies; ++k)
+      next[copies[k].dst] = next[copies[k].src] + T(copies[k].add);
     const T* current = pop.current();
     const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(far_interior_.size()) / batch;
     if (far_field_ == FarField::equilibrium) {

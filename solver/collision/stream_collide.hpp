@@ -147,8 +147,9 @@ template <int W, class Body>
   }
 }
 
-/// Redoes the collide-and-push of the interior nodes `nodes` (distinct linear indices) with Guo forcing, after stream_collide<false> of the whole block: every slot of
-/// next() receives from exactly one node, so overwriting the pushes of the forced nodes gives
+/// Redoes the collide-and-push of the interior nodes `nodes` (distinct linear indices) with Guo
+/// forcing, after stream_collide<false> of the whole block: every slot of next() receives from
+/// exactly one node, so overwriting the pushes of the forced nodes gives
 /// the forced step there and the unforced one (force zero) elsewhere. This keeps the forced
 /// kernel, about twice the cost per node, to the immersed boundary's stencils.
 template <class L, class T, class Op>
