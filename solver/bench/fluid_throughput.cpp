@@ -100,14 +100,20 @@ void check_flow(const Fluid& fluid) {
   }
 }
 
+/// Wall seconds of `steps` steps.
+template <class Fluid>
+double timed_steps(Fluid& fluid, long steps) {
+  const double t0 = now_seconds();
+  for (long i = 0; i < steps; ++i) fluid.step();
+  return now_seconds() - t0;
+}
+
 /// Batch length (steps) for about 1/5 of the minimum time, after one warm-up step (the first
 /// touch of the next buffer happens there) and one timed step.
 template <class Fluid>
 long batch_steps(Fluid& fluid, double min_seconds) {
   fluid.step();
-  const double t0 = now_seconds();
-  fluid.step();
-  const double t_step = std::max(now_seconds() - t0, 1e-9);
+  const double t_step = std::max(timed_steps(fluid, 1), 1e-9);
   return std::max(1L, static_cast<long>(std::ceil(min_seconds / 5 / t_step)));
 }
 
@@ -136,16 +142,12 @@ FluidMeasurement measure(const FluidCase& c, double min_seconds) {
   int batches = 0;
   std::vector<double> ratios;  // per batch pair: uniform twin MLUPS / two-level MLUPS
   while (elapsed < min_seconds || batches < 3) {
-    double t0 = now_seconds();
-    for (long i = 0; i < batch; ++i) fluid->step();
-    const double t = now_seconds() - t0;
+    const double t = timed_steps(*fluid, batch);
     elapsed += t;
     ++batches;
     r.mlups_best = std::max(r.mlups_best, batch * fluid->updates_per_step() / t * 1e-6);
     if (twin) {
-      t0 = now_seconds();
-      for (long i = 0; i < twin_batch; ++i) twin->step();
-      const double tt = now_seconds() - t0;
+      const double tt = timed_steps(*twin, twin_batch);
       twin_elapsed += tt;
       ratios.push_back((twin_batch * twin->updates_per_step() / tt) / (batch * fluid->updates_per_step() / t));
     }
