@@ -2,7 +2,8 @@
 // the equivalent ellipse (Taylor deformation parameter and inclination).
 //
 // The membrane is the closed polygon X_0 .. X_{N-1} (counter-clockwise; the last node joins
-// the first). All integrals are exact for the polygon (Green's theorem on each edge):
+// the first), or any region given by its oriented boundary edges (a capsule's section). All
+// integrals are exact for the polygon (Green's theorem on each edge):
 //   area      A   = 1/2 sum c_i,                     c_i = x_i y_{i+1} - x_{i+1} y_i (shoelace)
 //   centroid  C   = 1/(6A) sum (X_i + X_{i+1}) c_i
 //   moments   Jxx = int x^2 dA = 1/12 sum c_i (x_i^2 + x_i x_{i+1} + x_{i+1}^2), Jyy likewise,
@@ -20,6 +21,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <span>
 
 #include "core/vec.hpp"
@@ -56,5 +58,11 @@ Eigen::Matrix2d area_second_moment(std::span<const Vec<2>> X);
 /// Area, centroid and equivalent ellipse of the counter-clockwise polygon X. Throws
 /// core::Error when the signed area is not positive (clockwise or degenerate polygon).
 EquivalentEllipse equivalent_ellipse(std::span<const Vec<2>> X);
+
+/// Area, centroid and equivalent ellipse of the region bounded by the edges {p, q}, each with
+/// the region on its left (counter-clockwise contours cut into edges, in any order and any
+/// number of contours: the integrals above are sums over edges). Throws core::Error when the
+/// signed area is not positive.
+EquivalentEllipse equivalent_ellipse(std::span<const std::array<Vec<2>, 2>> edges);
 
 }  // namespace caplab::diagnostics

@@ -138,6 +138,15 @@ std::vector<std::array<Vec<3>, 2>> shear_plane_section(std::span<const Vec<3>> X
   return segments;
 }
 
+EquivalentEllipse shear_plane_section_ellipse(std::span<const Vec<3>> X,
+                                              std::span<const std::array<int, 3>> triangles, double y0) {
+  const auto segments = shear_plane_section(X, triangles, y0);
+  std::vector<std::array<Vec<2>, 2>> edges(segments.size());
+  for (std::size_t i = 0; i < segments.size(); ++i)
+    for (int k = 0; k < 2; ++k) edges[i][k] = Vec<2>(segments[i][k][0], segments[i][k][2]);
+  return equivalent_ellipse(std::span<const std::array<Vec<2>, 2>>(edges));
+}
+
 double max_area_change(std::span<const Vec<3>> X, std::span<const std::array<int, 3>> triangles,
                        std::span<const double> reference_areas) {
   CAPLAB_CHECK(reference_areas.size() == triangles.size(),

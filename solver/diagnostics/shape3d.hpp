@@ -1,6 +1,7 @@
 // Shape of a 3D capsule from its membrane triangles: the equivalent ellipsoid of the enclosed
 // volume (semi-axes, Taylor parameter D_xz in the shear plane, inclination), the contour of the
-// section with a plane y = y0, and the largest local area change of the membrane.
+// section with a plane y = y0 and its equivalent ellipse, and the largest local area change of
+// the membrane.
 //
 // The membrane is a closed, outward-oriented triangulation (geometry/triangle_mesh.hpp) in its
 // current configuration X. The integrals are exact for the polyhedron: the enclosed volume is
@@ -30,6 +31,7 @@
 #include <vector>
 
 #include "core/vec.hpp"
+#include "diagnostics/shape2d.hpp"
 
 namespace caplab::diagnostics {
 
@@ -57,6 +59,15 @@ EquivalentEllipsoid equivalent_ellipsoid(std::span<const Vec<3>> X,
 std::vector<std::array<Vec<3>, 2>> shear_plane_section(std::span<const Vec<3>> X,
                                                        std::span<const std::array<int, 3>> triangles,
                                                        double y0);
+
+/// The equivalent ellipse (shape2d.hpp) of the section with the plane y = y0, in the shear-plane
+/// coordinates (x, z): its inclination is the angle of the section's major axis from x toward z,
+/// in (−π/2, π/2], like the ellipsoid's, and its centroid is (x, z). Through the volume centroid
+/// (y0 = center[1]) it is the thesis's "middle cross section in the plane of shear" (6.3, fig.
+/// 6.14 and 6.16). Throws core::Error when the plane misses the surface or the section encloses
+/// no area.
+EquivalentEllipse shear_plane_section_ellipse(std::span<const Vec<3>> X,
+                                              std::span<const std::array<int, 3>> triangles, double y0);
 
 /// Largest local area change max_e |A_e / A0_e − 1| over the triangles (A0: reference_areas, one
 /// per triangle). Throws core::Error when the sizes differ.

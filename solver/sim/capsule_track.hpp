@@ -8,8 +8,9 @@
 // 3D (thesis ch. 5-6): the equivalent ellipsoid of the enclosed volume (diagnostics/shape3d.hpp)
 // in the shear plane x-z of u = (k z, 0, 0): D_xz, inclination, the semi-axes (length and
 // thickness in the shear plane, width along the vorticity axis y), the volume change, the
-// membrane area change (total and the largest local one) and the phase of the node that starts
-// at the largest x (on the shear plane through the centre).
+// membrane area change (total and the largest local one), the phase of the node that starts
+// at the largest x (on the shear plane through the centre), and, when asked for, the
+// inclination of the middle cross section in the shear plane (the thesis's angle of 6.3).
 //
 // update() runs once per coarse step, so the unwrapped angles follow tumbling and tank-treading
 // at any sampling interval. Angles are counter-clockwise from x in the shear plane (3D: from x
@@ -156,7 +157,7 @@ class CapsuleTrack<2> {
 template <>
 class CapsuleTrack<3> {
  public:
-  static constexpr std::array<CapsuleQuantity, 9> quantities{{
+  static constexpr std::array<CapsuleQuantity, 10> quantities{{
       {"taylor_deformation", "1",
        "D_xz = (L - B)/(L + B), L, B the semi-axes in the shear plane x-z of the ellipsoid with the second "
        "moments of the enclosed volume (thesis section 5.3.1.1)"},
@@ -171,9 +172,15 @@ class CapsuleTrack<3> {
       {"tank_treading_phase", "rad",
        "angle about the centroid, in the shear plane from x toward z, of the membrane node that starts at the "
        "largest x; continuous in time (tank-treading: decreasing)"},
+      {"section_inclination", "rad",
+       "angle from x toward z of the major axis of the ellipse with the second moments of the capsule's section "
+       "by the plane y = y_c through its volume centroid (the 'middle cross section in the plane of shear' of "
+       "thesis 6.3, fig. 6.14, 6.16), continuous in time"},
   }};
 
-  CapsuleTrack(const Capsule<3>& c, const membrane::FemMembrane& m) : fem_(&m) {
+  /// `section`: also follow the middle cross section (quantity section_inclination), a scan of
+  /// all triangles per step that only the cases that ask for it pay.
+  CapsuleTrack(const Capsule<3>& c, const membrane::FemMembrane& m, bool section) : fem_(&m), section_(section) {
     const auto X = c.positions();
     const auto& tris = m.triangles();
     volume0_ = geometry::enclosed_volume(X, tris);
@@ -190,11 +197,16 @@ class CapsuleTrack<3> {
     theta_ = follow_axis(angles_.inclination, shape_.taylor_xz, shape_.inclination);
     const Vec<3> r = X[tracked_] - shape_.center;
     phi_ = angles_.phase(std::atan2(r[2], r[0]));
+    if (section_) {
+      const auto s = diagnostics::shear_plane_section_ellipse(X, fem_->triangles(), shape_.center[1]);
+      section_theta_ = follow_axis(section_angle_, s.taylor, s.inclination);
+    }
   }
 
   double value(std::string_view q, const Capsule<3>& c, double /*velocity_lu*/) const {
     if (q == "taylor_deformation") return shape_.taylor_xz;
     if (q == "inclination") return theta_;
+    if (q == "section_inclination") return section_theta_;
     if (q == "length" || q == "width" || q == "thickness") return semi_axis(q);
     if (q == "volume_change") return volume_change();
     if (q == "surface_area_change") return geometry::surface_area(c.positions(), fem_->triangles()) / area0_ - 1.0;
@@ -209,7 +221,10 @@ class CapsuleTrack<3> {
   double volume_change() const { return shape_.volume / volume0_ - 1.0; }
 
   template <class Archive>
-  void checkpoint(Archive& ar, const std::string& prefix) { angles_.checkpoint(ar, prefix); }
+  void checkpoint(Archive& ar, const std::string& prefix) {
+    angles_.checkpoint(ar, prefix);
+    if (section_) section_angle_.checkpoint(ar, prefix + "section_inclination/");
+  }
 
   void add_to_snapshot(io::SnapshotWriter<3>& w, double t, const Capsule<3>& c) const {
     const auto X = c.positions();
@@ -242,11 +257,13 @@ class CapsuleTrack<3> {
   }
 
   const membrane::FemMembrane* fem_;
+  bool section_;
   double volume0_ = 0, area0_ = 0;
   std::size_t tracked_ = 0;
   diagnostics::EquivalentEllipsoid shape_;
   TrackAngles angles_;
-  double theta_ = 0.0, phi_ = 0.0;
+  diagnostics::AngleUnwrapper section_angle_{std::numbers::pi};
+  double theta_ = 0.0, phi_ = 0.0, section_theta_ = 0.0;
 };
 
 }  // namespace caplab::sim

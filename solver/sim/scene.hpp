@@ -396,7 +396,9 @@ class Scene {
       auto fem = std::make_unique<membrane::FemMembrane>(mesh, law);
       const auto& fem_ref = *fem;
       capsules_.emplace_back(b.name, std::move(mesh.nodes), std::move(fem), make_transfer());
-      capsule_tracks_.emplace_back(capsules_.back(), fem_ref);
+      const auto& q = spec_.outputs.series.quantities;
+      capsule_tracks_.emplace_back(capsules_.back(), fem_ref,
+                                   std::find(q.begin(), q.end(), "section_inclination") != q.end());
     }
   }
 
@@ -926,7 +928,7 @@ class Scene {
       const auto it = series.find(prefix + q);
       return it == series.end() ? nullptr : &it->second;
     };
-    for (const char* q : {"taylor_deformation", "inclination"}) {
+    for (const char* q : {"taylor_deformation", "inclination", "section_inclination"}) {
       const auto* v = column(q);
       if (!v) continue;
       const auto s = diagnostics::analyse_signal(t, *v, from);

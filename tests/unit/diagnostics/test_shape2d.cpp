@@ -1,10 +1,14 @@
 // Polygon shape diagnostics: exact area/centroid/moments of a rectangle, the equivalent
-// ellipse of sampled circles and ellipses (Taylor parameter, semi-axes, inclination), and
-// rejection of clockwise polygons.
+// ellipse of sampled circles and ellipses (Taylor parameter, semi-axes, inclination), the same
+// from a region's boundary edges in any order (also a region with a hole), and rejection of
+// clockwise polygons.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <random>
 #include <vector>
 
 #include "core/error.hpp"
@@ -136,6 +140,49 @@ TEST(Shape2d, RejectsClockwiseAndDegeneratePolygons) {
   const std::vector<Vec<2>> two = {{0, 0}, {1, 0}};
   EXPECT_DOUBLE_EQ(geometry::polygon_area(two), 0.0);
   EXPECT_THROW(area_second_moment(two), core::Error);
+}
+
+// The polygon's edges X_i -> X_{i+1}, shuffled.
+std::vector<std::array<Vec<2>, 2>> shuffled_edges(const std::vector<Vec<2>>& X, unsigned seed) {
+  std::vector<std::array<Vec<2>, 2>> edges;
+  for (std::size_t i = 0; i < X.size(); ++i) edges.push_back({X[i], X[(i + 1) % X.size()]});
+  std::shuffle(edges.begin(), edges.end(), std::mt19937(seed));
+  return edges;
+}
+
+TEST(Shape2d, EdgesInAnyOrderGiveThePolygonsEllipse) {
+  const auto X = ellipse(Vec<2>(0.3, -1), 2.0, 1.0, 0.4, 200);
+  const auto p = equivalent_ellipse(X);
+  const auto edges = shuffled_edges(X, 7);
+  const auto e = equivalent_ellipse(std::span<const std::array<Vec<2>, 2>>(edges));
+  EXPECT_NEAR(e.area, p.area, 1e-12);
+  EXPECT_NEAR((e.centroid - p.centroid).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(e.taylor, p.taylor, 1e-12);
+  EXPECT_NEAR(e.inclination, 0.4, 1e-12);
+  // Reversed edges bound a clockwise region: rejected like a clockwise polygon.
+  auto reversed = edges;
+  for (auto& edge : reversed) std::swap(edge[0], edge[1]);
+  EXPECT_THROW(equivalent_ellipse(std::span<const std::array<Vec<2>, 2>>(reversed)), core::Error);
+}
+
+TEST(Shape2d, EdgesOfARegionWithAHole) {
+  // Square [-2, 2]^2 less the square [-1, 1]^2 (the hole's edges clockwise, the region on their
+  // left): area 16 - 4, centred, second moments isotropic (D = 0).
+  const std::vector<Vec<2>> outer = {{-2, -2}, {2, -2}, {2, 2}, {-2, 2}};
+  const std::vector<Vec<2>> inner = {{-1, -1}, {-1, 1}, {1, 1}, {1, -1}};
+  auto edges = shuffled_edges(outer, 1);
+  for (const auto& e : shuffled_edges(inner, 2)) edges.push_back(e);
+  const auto e = equivalent_ellipse(std::span<const std::array<Vec<2>, 2>>(edges));
+  EXPECT_NEAR(e.area, 12.0, 1e-14);
+  EXPECT_NEAR(e.centroid.norm(), 0.0, 1e-14);
+  EXPECT_NEAR(e.taylor, 0.0, 1e-14);
+  // Stretched along x by 2: the moments scale by 8 (xx) and 2 (yy), D = (2 - 1)/(2 + 1).
+  for (auto& edge : edges)
+    for (auto& x : edge) x[0] *= 2;
+  const auto s = equivalent_ellipse(std::span<const std::array<Vec<2>, 2>>(edges));
+  EXPECT_NEAR(s.area, 24.0, 1e-13);
+  EXPECT_NEAR(s.taylor, 1.0 / 3.0, 1e-14);
+  EXPECT_NEAR(s.inclination, 0.0, 1e-14);
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // Shape diagnostics of 3D capsules: exact second moments of a scaled octahedron, the
 // equivalent ellipsoid of sphere and ellipsoid meshes (semi-axes with their convergence, D_xz,
 // inclination at several angles, translation invariance, a long axis along the vorticity axis),
-// rejection of inward surfaces, sections with a plane y = y0, and the local area change.
+// rejection of inward surfaces, sections with a plane y = y0 and their equivalent ellipse, and
+// the local area change.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -204,6 +205,26 @@ TEST(Shape3d, SphereSectionOffTheMeshLines) {
   expect_closed_contours(segments);
   EXPECT_NEAR(section_area(segments) / (pi * rho * rho), 1.0, 5e-3);
   EXPECT_TRUE(shear_plane_section(m.nodes, m.triangles, 2.0).empty());  // misses the sphere
+}
+
+TEST(Shape3d, SectionEllipseOfATiltedEllipsoid) {
+  // The section y = 0 of the sphere mesh runs along mesh edges and has the octahedron's
+  // four-fold symmetry, so its second moments are isotropic; scaling by (1.6, 1, 0.7) and
+  // turning about y map the plane y = 0 onto itself, so the section's ellipse has exactly the
+  // ratio 1.6 : 0.7 and the tilt.
+  const Vec<3> semi(1.6, 1.0, 0.7), shift(0.5, -0.25, 2.0);
+  const TriangleMesh sphere = geometry::octahedron_sphere(4, 1.0);
+  for (double theta : {0.0, 0.3, -0.7, 1.2}) {
+    const TriangleMesh m = transformed(sphere, semi, about_y(theta), shift);
+    const auto e = shear_plane_section_ellipse(m.nodes, m.triangles, shift[1]);
+    EXPECT_NEAR(e.taylor, (1.6 - 0.7) / (1.6 + 0.7), 1e-13) << "theta " << theta;
+    EXPECT_NEAR(e.inclination, theta, 1e-13) << "theta " << theta;
+    EXPECT_NEAR((e.centroid - Vec<2>(shift[0], shift[2])).norm(), 0.0, 1e-13);
+    // Same angle as the ellipsoid's (x toward z).
+    EXPECT_NEAR(e.inclination, ellipsoid_of(m).inclination, 1e-12);
+  }
+  const TriangleMesh m = transformed(sphere, semi, about_y(0.3), shift);
+  EXPECT_THROW(shear_plane_section_ellipse(m.nodes, m.triangles, shift[1] + 1.5), core::Error);  // misses it
 }
 
 TEST(Shape3d, MaxAreaChange) {
