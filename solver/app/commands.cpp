@@ -40,6 +40,7 @@ void print_units(const cases::CaseSpec& spec, const sim::LatticeUnits& u) {
 
 int check(const CheckArgs& args) {
   const auto spec = cases::load_case(args.case_file, args.fidelity, args.overrides);
+  sim::check_series_quantities(spec);
   const auto u = sim::derive_units(spec);
   print_units(spec, u);
   fmt::print("  steps {} (coarse), node updates {:.3g}, memory {:.1f} MiB\n", u.coarse_steps, u.node_updates,

@@ -99,6 +99,13 @@ RunResult drive(const cases::CaseSpec& spec, const LatticeUnits& units, int thre
 
 }  // namespace
 
+void check_series_quantities(const cases::CaseSpec& spec) {
+  if (spec.physics.dimension == 2)
+    check_series_quantities<2>(spec);
+  else
+    check_series_quantities<3>(spec);
+}
+
 std::string supported_combinations() { return "dimension 2 (D2Q9) or 3 (D3Q19) × precision double|single × collision bgk|trt"; }
 
 RunResult run_case(const cases::CaseSpec& spec, const std::filesystem::path& out, const ProgressFn& progress,

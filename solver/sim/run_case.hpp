@@ -39,6 +39,10 @@ struct ResumedRun {
 ResumedRun resume_case(const std::filesystem::path& run_dir, int threads, const ProgressFn& progress,
                        const RunOptions& options = {});
 
+/// Throws core::InputError when the case asks for a series quantity its dimension and bodies
+/// cannot give (scene.hpp check_series_quantities<D>); `caplab check` calls it.
+void check_series_quantities(const cases::CaseSpec& spec);
+
 /// The supported combinations, for messages: "2D/3D × double/single × bgk/trt".
 std::string supported_combinations();
 

@@ -67,6 +67,32 @@ struct RunResult {
   nlohmann::json checkpoints;  ///< count, seconds, bytes of the checkpoints written
 };
 
+/// Throws core::InputError (the file, /outputs/series/quantities, the name, what is allowed)
+/// when `spec` asks for a series quantity a D-dimensional scene with its bodies cannot give: an
+/// unknown name, a rigid-body quantity without rigid bodies, a capsule quantity without capsules.
+/// `caplab check` applies it as the scene does, before anything runs.
+template <int D>
+void check_series_quantities(const cases::CaseSpec& spec) {
+  const auto& bodies = spec.physics.bodies;
+  const bool rigid = std::any_of(bodies.begin(), bodies.end(), [](const auto& b) { return !b.membrane; });
+  const bool capsules = std::any_of(bodies.begin(), bodies.end(), [](const auto& b) { return b.membrane.has_value(); });
+  const auto& list = CapsuleTrack<D>::quantities;
+  for (const auto& q : spec.outputs.series.quantities) {
+    auto refuse = [&](const std::string& expected) {
+      throw core::InputError(spec.source_file, "/outputs/series/quantities", q, expected);
+    };
+    if (q == "drag_coefficient" || q == "lift_coefficient" || q == "position") {
+      if (!rigid) refuse("a quantity of a scene with bodies (this case has none)");
+    } else if (std::any_of(list.begin(), list.end(), [&](const CapsuleQuantity& c) { return c.name == q; })) {
+      if (!capsules) refuse("a quantity of a scene with capsules (this case has none)");
+    } else if (q != "mass" && q != "kinetic_energy") {
+      std::string names = "drag_coefficient, lift_coefficient, position";
+      for (const auto& info : list) names += ", " + std::string(info.name);
+      refuse(fmt::format("one of {}, mass, kinetic_energy ({}D)", names, D));
+    }
+  }
+}
+
 template <class L, class T, class Op>
 class Scene {
  public:
@@ -613,20 +639,17 @@ class Scene {
   }
 
   void build_series_columns() {
+    check_series_quantities<D>(spec_);
     columns_.push_back({"t", "L/U", "time in units of the reference length over the reference velocity"});
     const bool many = bodies_.size() > 1;
     for (const auto& q : spec_.outputs.series.quantities) {
       if (q == "drag_coefficient" || q == "lift_coefficient") {
-        if (bodies_.empty())
-          throw core::InputError(spec_.source_file, "/outputs/series/quantities", q, "a quantity of a scene with bodies (this case has none)");
         const std::string over = " / (0.5 rho U^2 D) (2D: per unit span, D the diameter or an ellipse's chord; 3D: "
                                  "over the area pi D^2/4); moving bodies include the inertia of their inner fluid";
         for (const auto& b : bodies_)
           columns_.push_back({many ? b.name + "." + q : q, "1",
                               (q == "drag_coefficient" ? "C_d = F_drag" : "C_l = F_lift") + over});
       } else if (q == "position") {
-        if (bodies_.empty())
-          throw core::InputError(spec_.source_file, "/outputs/series/quantities", q, "a quantity of a scene with bodies (this case has none)");
         for (const auto& b : bodies_) {
           const std::string prefix = many ? b.name + "." : "";
           for (int a = 0; a < D; ++a)
@@ -634,22 +657,14 @@ class Scene {
           if constexpr (D == 2) columns_.push_back({prefix + "angle", "rad", "orientation of the body's long axis from x"});
         }
       } else if (is_capsule_quantity(q)) {
-        if (capsules_.empty())
-          throw core::InputError(spec_.source_file, "/outputs/series/quantities", q,
-                                 "a quantity of a scene with capsules (this case has none)");
         const auto& info = capsule_quantity(q);
         for (const auto& c : capsules_)
           columns_.push_back({capsules_.size() > 1 ? c.name() + "." + q : q, std::string(info.unit),
                               std::string(info.definition)});
       } else if (q == "mass") {
         columns_.push_back({"mass", "1", "total fluid mass over its initial value"});
-      } else if (q == "kinetic_energy") {
+      } else {  // kinetic_energy (check_series_quantities refused any other name)
         columns_.push_back({"kinetic_energy", "rho U^2 L^D", "integral of rho u^2 / 2 over the domain"});
-      } else {
-        std::string names = "drag_coefficient, lift_coefficient, position";
-        for (const auto& info : CapsuleTrack<D>::quantities) names += ", " + std::string(info.name);
-        throw core::InputError(spec_.source_file, "/outputs/series/quantities", q,
-                               fmt::format("one of {}, mass, kinetic_energy ({}D)", names, D));
       }
     }
   }
