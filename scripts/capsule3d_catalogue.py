@@ -63,7 +63,8 @@ def stable_time_step(re, a_lu, G, law, C=None, tau_f=3.5):
 
 def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, fine, fine_per_a, subdivisions,
          end_time, average_from, walls=False, C=None, refinement="two_level", tau_f=3.5,
-         acceptance=(), quick_end=None, snapshots=(), quick_speedup=2, performance=None, quick_margin=0):
+         acceptance=(), quick_end=None, snapshots=(), quick_speedup=2, performance=None, quick_margin=0,
+         series=SERIES):
     u = lattice_velocity(re, fine_per_a, tau_f)
     membrane = {"law": law, "capillary": G, "subdivisions": subdivisions}
     if C is not None:
@@ -112,7 +113,7 @@ def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, f
             "thesis": {"numerics.precision": "double"},
         },
         "outputs": {
-            "series": {"interval": 0.05, "quantities": SERIES},
+            "series": {"interval": 0.05, "quantities": list(series)},
             # t = 0: the rest mesh (XDMF, with the fluid's initial state).
             "snapshots": {"times": [0] + (list(snapshots) or [end_time]), "fields": ["velocity", "vorticity"]},
             "average_from": average_from,

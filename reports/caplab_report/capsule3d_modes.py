@@ -573,7 +573,7 @@ def amplitude_figure(sweeps: list[Sweep], amp: Band) -> Figure | None:
         curves = ([], [])  # the tank-treading points, joined; a tumbling one stands alone
         for g, mode, run in s.points():
             tumbles = mode == TUMBLING
-            values = (180.0 if tumbles else _deg(run.metric("inclination_amplitude")),
+            values = (180.0 if tumbles else _deg(inclination_amplitude(run)),
                       run.metric("taylor_deformation_amplitude"))
             for ax, y, curve in zip(axes, values, curves):
                 if y is not None and (ax is axes[1] or y > 0):
@@ -601,7 +601,9 @@ def amplitude_figure(sweeps: list[Sweep], amp: Band) -> Figure | None:
     return Figure(capsule3d._finish(fig, axes, "amplitudes of the inclination and of D_xz against G"),
                   "Oscillation amplitudes against G (log), per sweep "
                   f"({fidelity_text([r for s in shown for r in s.runs])}): left, summary inclination_amplitude "
-                  "((max − min)/2 of θ over k t ≥ outputs.average_from) in degrees (log axis); right, "
+                  "((max − min)/2 of θ over k t ≥ outputs.average_from; section_inclination_amplitude, the middle "
+                  "cross section's θ that thesis fig. 6.14 plots, where the run measured it: the biconcave cells) in "
+                  "degrees (log axis); right, "
                   "taylor_deformation_amplitude of D_xz (dimensionless). Markers give the mode; lines join the "
                   "tank-treading runs of a sweep. A tumbling run has no oscillation amplitude (θ decreases without "
                   "bound): it is drawn at π (open markers), as the thesis does in fig. 6.7 ('below which the "
@@ -683,6 +685,14 @@ def _deg(x):
     return math.degrees(x) if x is not None else None
 
 
+def inclination_amplitude(run: Run):
+    """The run's inclination amplitude (rad): that of the middle cross section
+    (``section_inclination_amplitude``, the angle thesis 6.3 plots for the biconcave cells) where the run
+    measured it, else that of the equivalent ellipsoid's axis (``inclination_amplitude``)."""
+    section = run.metric("section_inclination_amplitude")
+    return section if section is not None else run.metric("inclination_amplitude")
+
+
 def table_row(run: Run, cache: dict) -> dict:
     p = params(run)
     done = run.status == "ok"
@@ -692,10 +702,11 @@ def table_row(run: Run, cache: dict) -> dict:
            "capillary": p["capillary"], "area_dilation": p.get("area_dilation"), "status": run.status_label,
            "done": done, "mode": capsule.mode_of(run) if done else None, "wall": run.perf("wall_time_s")}
     row["mode_text"] = MODE_WORDS.get(row["mode"], row["mode"] or ("no mode" if done else run.status_label))
-    for key, metric in (("theta_amp", "inclination_amplitude"), ("d_amp", "taylor_deformation_amplitude"),
-                        ("d_mean", "taylor_deformation_mean"), ("theta_mean", "inclination_mean"),
-                        ("frequency", "tank_treading_frequency_per_k")):
+    for key, metric in (("d_amp", "taylor_deformation_amplitude"), ("d_mean", "taylor_deformation_mean"),
+                        ("theta_mean", "inclination_mean"), ("frequency", "tank_treading_frequency_per_k")):
         row[key] = run.metric(metric) if done else None
+    row["theta_amp"] = inclination_amplitude(run) if done else None
+    row["theta_section"] = done and run.metric("section_inclination_amplitude") is not None
     row["theta_amp"], row["theta_mean"] = _deg(row["theta_amp"]), _deg(row["theta_mean"])
     for key, metric, column in (("area", "surface_area_change_max", "surface_area_change"),
                                 ("local", "max_area_change_max", "max_area_change"),

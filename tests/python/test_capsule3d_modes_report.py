@@ -90,9 +90,10 @@ def catalogue_case(name: str) -> dict:
 
 def ch6_run(results: Path, name: str, mode: str | None, status: str = "ok", fidelity: str = "quick",
             amplitude_deg: float = 3.0, d_amplitude: float = 0.02, frequency: float | None = None,
-            area: float | None = None) -> Path:
-    """A run of catalogue/ch6/<name>.json that behaves as ``mode`` says: summary mode and amplitudes,
-    and an inclination history (swinging about 20 degrees, tumbling at -0.4 rad per k t)."""
+            area: float | None = None, section_deg: float | None = None) -> Path:
+    """A run of catalogue/ch6/<name>.json that behaves as ``mode`` says: summary mode and amplitudes
+    (``section_deg``: also the middle cross section's), and an inclination history (swinging about 20
+    degrees, tumbling at -0.4 rad per k t)."""
     case = catalogue_case(name)
     d = derive(results, case["id"], edit=lambda c: (c.clear(), c.update(case)), status=status, snapshots=False)
     if fidelity != "quick":
@@ -108,6 +109,8 @@ def ch6_run(results: Path, name: str, mode: str | None, status: str = "ok", fide
         m["mode"]["value"] = mode
     m["inclination_amplitude"]["value"] = math.radians(amplitude_deg) if mode != T else 4.0
     m["taylor_deformation_amplitude"]["value"] = d_amplitude
+    if section_deg is not None:
+        m["section_inclination_amplitude"] = {"value": math.radians(section_deg), "unit": "rad", "definition": "(max - min)/2"}
     if frequency is not None:
         m["tank_treading_frequency_per_k"] = {"value": frequency, "unit": "1", "definition": "f/k = 2 pi/(k T)"}
     if area is not None:
@@ -138,7 +141,7 @@ def make_results(results: Path) -> None:
     for name, mode in SWEEP:
         extra = {}
         if name == "biconcave_sk_walls_G1.87":
-            extra = {"amplitude_deg": 3.1, "frequency": 0.215}
+            extra = {"amplitude_deg": 3.1, "section_deg": 3.4, "frequency": 0.215}
         if name.startswith("sphere_zt"):
             extra = {"area": 0.004 if "0.0125" in name else 0.21, "amplitude_deg": 0.01}
         if mode == "diverged":
@@ -307,10 +310,13 @@ def test_family_tables(built):
     diverged = next(r for r in zt.rows if r["run"].case_id == "ch6/oblate_zt_3to2_G0.025")
     assert not diverged["done"] and diverged["status"] == "DIVERGED" and diverged["theta_amp"] is None
     bic = next(r for r in tables["SK biconcave discoids between walls (C from G)"].rows if r["capillary"] == 1.87)
-    assert bic["mode_text"] == "swinging" and bic["theta_amp"] == pytest.approx(3.1) and bic["frequency"] == 0.215
+    # The middle cross section's amplitude where the run has it (thesis fig. 6.14), marked so.
+    assert bic["mode_text"] == "swinging" and bic["theta_amp"] == pytest.approx(3.4) and bic["theta_section"]
+    assert bic["frequency"] == 0.215
     membrane = catalogue_case("biconcave_sk_walls_G1.87")["physics"]["bodies"][0]["membrane"]
     assert bic["area_dilation"] == membrane["area_dilation"]
-    assert re.search(r"ch6/biconcave_sk_walls_G1\.87 \(quick\) quick 1\.87 \d+ swinging 3\.1 ", built["text"])
+    assert re.search(r"ch6/biconcave_sk_walls_G1\.87 \(quick\) quick 1\.87 \d+ swinging 3\.4 s ", built["text"])
+    assert not next(r for r in zt.rows if r["done"])["theta_section"]
 
 
 def test_a_broken_run_does_not_stop_the_section(tmp_path, monkeypatch):
