@@ -5,66 +5,60 @@
 #include <numbers>
 #include <sstream>
 #include <string>
-#include <utility>
 
 #include "core/error.hpp"
 
 namespace caplab::diagnostics {
 namespace {
 
-// Area integrals of a region relative to a reference point p: A, int r dA, int r r^T dA, from
-// its boundary edges {a, b} (Green's theorem on each edge; the region on the left of every edge).
+// Area integrals of a region relative to a reference point p: A, int r dA, int r r^T dA.
 struct Moments {
   double area = 0;
   Vec<2> first = Vec<2>::Zero();
   Eigen::Matrix2d second = Eigen::Matrix2d::Zero();
 };
 
-// `edge(i)` returns edge i of `n` as a pair of end points.
-template <class EdgeAt>
-Moments moments_about(std::size_t n, EdgeAt edge, const Vec<2>& p) {
-  Moments m;
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto [A, B] = edge(i);
-    const Vec<2> a = A - p, b = B - p;
-    const double c = a[0] * b[1] - b[0] * a[1];
-    m.area += c;
-    m.first += c * (a + b);
-    m.second(0, 0) += c * (a[0] * a[0] + a[0] * b[0] + b[0] * b[0]);
-    m.second(1, 1) += c * (a[1] * a[1] + a[1] * b[1] + b[1] * b[1]);
-    m.second(0, 1) += c * (2 * a[0] * a[1] + a[0] * b[1] + b[0] * a[1] + 2 * b[0] * b[1]);
+}  // namespace
+
+// The finished integrals of a RegionMoments, checked to enclose a positive area.
+struct RegionMomentsAccess {
+  static Moments checked(const RegionMoments& r, const char* what) {
+    Moments m;
+    m.area = 0.5 * r.area_;
+    m.first = r.first_ / 6.0;
+    m.second(0, 0) = r.second_(0, 0) / 12.0;
+    m.second(1, 1) = r.second_(1, 1) / 12.0;
+    m.second(0, 1) = m.second(1, 0) = r.second_(0, 1) / 24.0;
+    std::ostringstream msg;
+    msg << "shape diagnostics: the " << what << " of " << r.edges_ << " edges has signed area " << m.area
+        << "; expected a counter-clockwise boundary (positive area) with at least 3 edges";
+    CAPLAB_CHECK(r.edges_ >= 3 && m.area > 0.0, msg.str());
+    return m;
   }
-  m.area *= 0.5;
-  m.first /= 6.0;
-  m.second(0, 0) /= 12.0;
-  m.second(1, 1) /= 12.0;
-  m.second(0, 1) /= 24.0;
-  m.second(1, 0) = m.second(0, 1);
-  return m;
+};
+
+void RegionMoments::add_edge(const Vec<2>& A, const Vec<2>& B) {
+  const Vec<2> a = A - reference_, b = B - reference_;
+  const double c = a[0] * b[1] - b[0] * a[1];
+  area_ += c;
+  first_ += c * (a + b);
+  second_(0, 0) += c * (a[0] * a[0] + a[0] * b[0] + b[0] * b[0]);
+  second_(1, 1) += c * (a[1] * a[1] + a[1] * b[1] + b[1] * b[1]);
+  second_(0, 1) += c * (2 * a[0] * a[1] + a[0] * b[1] + b[0] * a[1] + 2 * b[0] * b[1]);
+  ++edges_;
 }
 
-// Moments about the mean of the edges' start points (against cancellation), checked to enclose
-// a positive area.
-template <class EdgeAt>
-Moments checked_moments(std::size_t n, EdgeAt edge, Vec<2>& reference, const char* what) {
-  reference = Vec<2>::Zero();
-  for (std::size_t i = 0; i < n; ++i) reference += edge(i).first;
-  if (n > 0) reference /= static_cast<double>(n);
-  const Moments m = moments_about(n, edge, reference);
-  std::ostringstream msg;
-  msg << "shape diagnostics: the " << what << " of " << n << " edges has signed area " << m.area
-      << "; expected a counter-clockwise boundary (positive area) with at least 3 edges";
-  CAPLAB_CHECK(n >= 3 && m.area > 0.0, msg.str());
-  return m;
-}
+namespace {
 
-// The closed polygon X as edges X_i -> X_{i+1}, the last joining the first.
-auto polygon_edges(std::span<const Vec<2>> X) {
-  return [X](std::size_t i) { return std::pair<Vec<2>, Vec<2>>(X[i], X[(i + 1) % X.size()]); };
-}
-
+// Moments of the closed polygon X (edges X_i -> X_{i+1}, the last joining the first) about its
+// vertex mean `reference` (against cancellation), checked to enclose a positive area.
 Moments checked_moments(std::span<const Vec<2>> X, Vec<2>& reference) {
-  return checked_moments(X.size(), polygon_edges(X), reference, "polygon");
+  reference = Vec<2>::Zero();
+  for (const Vec<2>& x : X) reference += x;
+  if (!X.empty()) reference /= static_cast<double>(X.size());
+  RegionMoments r(reference);
+  for (std::size_t i = 0; i < X.size(); ++i) r.add_edge(X[i], X[(i + 1) % X.size()]);
+  return RegionMomentsAccess::checked(r, "polygon");
 }
 
 // Area, centroid and second moments about the centroid.
@@ -142,11 +136,8 @@ EquivalentEllipse equivalent_ellipse(std::span<const Vec<2>> X) {
   return ellipse_of(central(m, p));
 }
 
-EquivalentEllipse equivalent_ellipse(std::span<const std::array<Vec<2>, 2>> edges) {
-  const auto edge = [edges](std::size_t i) { return std::pair<Vec<2>, Vec<2>>(edges[i][0], edges[i][1]); };
-  Vec<2> p;
-  const Moments m = checked_moments(edges.size(), edge, p, "region bounded by edges");
-  return ellipse_of(central(m, p));
+EquivalentEllipse RegionMoments::ellipse(const char* what) const {
+  return ellipse_of(central(RegionMomentsAccess::checked(*this, what), reference_));
 }
 
 }  // namespace caplab::diagnostics

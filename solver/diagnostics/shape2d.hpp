@@ -2,8 +2,8 @@
 // the equivalent ellipse (Taylor deformation parameter and inclination).
 //
 // The membrane is the closed polygon X_0 .. X_{N-1} (counter-clockwise; the last node joins
-// the first), or any region given by its oriented boundary edges (a capsule's section). All
-// integrals are exact for the polygon (Green's theorem on each edge):
+// the first), or any region given by its oriented boundary edges (RegionMoments, a capsule's
+// section). All integrals are exact for the polygon (Green's theorem on each edge):
 //   area      A   = 1/2 sum c_i,                     c_i = x_i y_{i+1} - x_{i+1} y_i (shoelace)
 //   centroid  C   = 1/(6A) sum (X_i + X_{i+1}) c_i
 //   moments   Jxx = int x^2 dA = 1/12 sum c_i (x_i^2 + x_i x_{i+1} + x_{i+1}^2), Jyy likewise,
@@ -21,7 +21,7 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <array>
+#include <cstddef>
 #include <span>
 
 #include "core/vec.hpp"
@@ -59,10 +59,28 @@ Eigen::Matrix2d area_second_moment(std::span<const Vec<2>> X);
 /// core::Error when the signed area is not positive (clockwise or degenerate polygon).
 EquivalentEllipse equivalent_ellipse(std::span<const Vec<2>> X);
 
-/// Area, centroid and equivalent ellipse of the region bounded by the edges {p, q}, each with
-/// the region on its left (counter-clockwise contours cut into edges, in any order and any
-/// number of contours: the integrals above are sums over edges). Throws core::Error when the
-/// signed area is not positive.
-EquivalentEllipse equivalent_ellipse(std::span<const std::array<Vec<2>, 2>> edges);
+/// The area integrals above accumulated one boundary edge at a time, for a region whose edges
+/// are produced one by one and never stored (a capsule's section, shape3d.hpp): edges in any
+/// order and any number of contours, each with the region on its left. The sums are taken
+/// relative to `reference`, a point near the region (against cancellation).
+class RegionMoments {
+ public:
+  explicit RegionMoments(const Vec<2>& reference) : reference_(reference) {}
+
+  /// Adds the edge from `a` to `b`.
+  void add_edge(const Vec<2>& a, const Vec<2>& b);
+
+  /// Area, centroid and equivalent ellipse of the region. Throws core::Error naming `what`
+  /// when the signed area is not positive or there are fewer than 3 edges.
+  EquivalentEllipse ellipse(const char* what = "region bounded by edges") const;
+
+ private:
+  friend struct RegionMomentsAccess;
+  Vec<2> reference_;
+  std::size_t edges_ = 0;
+  double area_ = 0;                                      // 2 A
+  Vec<2> first_ = Vec<2>::Zero();                        // 6 int r dA
+  Eigen::Matrix2d second_ = Eigen::Matrix2d::Zero();     // 12 int x^2, 12 int y^2, 24 int x y
+};
 
 }  // namespace caplab::diagnostics

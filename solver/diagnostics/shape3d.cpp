@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -118,10 +119,13 @@ EquivalentEllipsoid equivalent_ellipsoid(std::span<const Vec<3>> X,
   return e;
 }
 
-std::vector<std::array<Vec<3>, 2>> shear_plane_section(std::span<const Vec<3>> X,
-                                                       std::span<const std::array<int, 3>> triangles,
-                                                       double y0) {
-  std::vector<std::array<Vec<3>, 2>> segments;
+namespace {
+
+// Calls segment(p, q) for each triangle the plane y = y0 crosses, p -> q counter-clockwise in
+// (x, z) (see shear_plane_section).
+template <class Segment>
+void for_each_section_segment(std::span<const Vec<3>> X, std::span<const std::array<int, 3>> triangles, double y0,
+                              Segment&& segment) {
   for (const auto& t : triangles) {
     std::array<bool, 3> above;
     for (int k = 0; k < 3; ++k) above[k] = X[t[k]][1] >= y0;
@@ -133,18 +137,32 @@ std::vector<std::array<Vec<3>, 2>> shear_plane_section(std::span<const Vec<3>> X
     // Counter-clockwise in (x, z): along n × e_y = (−n_z, 0, n_x), n the outward normal.
     const Vec<3> n = geometry::area_vector(X, t);
     if ((s[1] - s[0]).dot(Vec<3>(-n[2], 0.0, n[0])) < 0.0) std::swap(s[0], s[1]);
-    segments.push_back(s);
+    segment(s[0], s[1]);
   }
+}
+
+}  // namespace
+
+std::vector<std::array<Vec<3>, 2>> shear_plane_section(std::span<const Vec<3>> X,
+                                                       std::span<const std::array<int, 3>> triangles,
+                                                       double y0) {
+  std::vector<std::array<Vec<3>, 2>> segments;
+  for_each_section_segment(X, triangles, y0, [&](const Vec<3>& p, const Vec<3>& q) { segments.push_back({p, q}); });
   return segments;
 }
 
 EquivalentEllipse shear_plane_section_ellipse(std::span<const Vec<3>> X,
                                               std::span<const std::array<int, 3>> triangles, double y0) {
-  const auto segments = shear_plane_section(X, triangles, y0);
-  std::vector<std::array<Vec<2>, 2>> edges(segments.size());
-  for (std::size_t i = 0; i < segments.size(); ++i)
-    for (int k = 0; k < 2; ++k) edges[i][k] = Vec<2>(segments[i][k][0], segments[i][k][2]);
-  return equivalent_ellipse(std::span<const std::array<Vec<2>, 2>>(edges));
+  // Accumulated as the segments come (no buffer: the capsule track calls this every step),
+  // relative to the first segment's start, which lies on the section.
+  std::optional<RegionMoments> moments;
+  for_each_section_segment(X, triangles, y0, [&](const Vec<3>& p, const Vec<3>& q) {
+    const Vec<2> a(p[0], p[2]), b(q[0], q[2]);
+    if (!moments) moments.emplace(a);
+    moments->add_edge(a, b);
+  });
+  CAPLAB_CHECK(moments.has_value(), "shape diagnostics: the plane y = " + std::to_string(y0) + " misses the surface");
+  return moments->ellipse("section");
 }
 
 double max_area_change(std::span<const Vec<3>> X, std::span<const std::array<int, 3>> triangles,

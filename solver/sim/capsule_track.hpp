@@ -266,4 +266,12 @@ class CapsuleTrack<3> {
   double theta_ = 0.0, phi_ = 0.0, section_theta_ = 0.0;
 };
 
+/// The quantity named `q` of a D-dimensional capsule track, or nullptr.
+template <int D>
+const CapsuleQuantity* find_capsule_quantity(std::string_view q) {
+  const auto& list = CapsuleTrack<D>::quantities;
+  const auto it = std::find_if(list.begin(), list.end(), [&](const CapsuleQuantity& c) { return c.name == q; });
+  return it == list.end() ? nullptr : &*it;
+}
+
 }  // namespace caplab::sim

@@ -76,18 +76,17 @@ void check_series_quantities(const cases::CaseSpec& spec) {
   const auto& bodies = spec.physics.bodies;
   const bool rigid = std::any_of(bodies.begin(), bodies.end(), [](const auto& b) { return !b.membrane; });
   const bool capsules = std::any_of(bodies.begin(), bodies.end(), [](const auto& b) { return b.membrane.has_value(); });
-  const auto& list = CapsuleTrack<D>::quantities;
   for (const auto& q : spec.outputs.series.quantities) {
     auto refuse = [&](const std::string& expected) {
       throw core::InputError(spec.source_file, "/outputs/series/quantities", q, expected);
     };
     if (q == "drag_coefficient" || q == "lift_coefficient" || q == "position") {
       if (!rigid) refuse("a quantity of a scene with bodies (this case has none)");
-    } else if (std::any_of(list.begin(), list.end(), [&](const CapsuleQuantity& c) { return c.name == q; })) {
+    } else if (find_capsule_quantity<D>(q)) {
       if (!capsules) refuse("a quantity of a scene with capsules (this case has none)");
     } else if (q != "mass" && q != "kinetic_energy") {
       std::string names = "drag_coefficient, lift_coefficient, position";
-      for (const auto& info : list) names += ", " + std::string(info.name);
+      for (const auto& info : CapsuleTrack<D>::quantities) names += ", " + std::string(info.name);
       refuse(fmt::format("one of {}, mass, kinetic_energy ({}D)", names, D));
     }
   }
@@ -669,14 +668,9 @@ class Scene {
     }
   }
 
-  static bool is_capsule_quantity(const std::string& q) {
-    const auto& list = CapsuleTrack<D>::quantities;
-    return std::any_of(list.begin(), list.end(), [&](const CapsuleQuantity& c) { return c.name == q; });
-  }
-  static const CapsuleQuantity& capsule_quantity(const std::string& q) {
-    const auto& list = CapsuleTrack<D>::quantities;
-    return *std::find_if(list.begin(), list.end(), [&](const CapsuleQuantity& c) { return c.name == q; });
-  }
+  static bool is_capsule_quantity(const std::string& q) { return find_capsule_quantity<D>(q) != nullptr; }
+  /// A capsule quantity's unit and definition (q is one: the series columns were checked).
+  static const CapsuleQuantity& capsule_quantity(const std::string& q) { return *find_capsule_quantity<D>(q); }
 
   void sample(double t, std::vector<double>& row) {
     std::size_t k = 0;

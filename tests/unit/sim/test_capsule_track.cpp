@@ -47,10 +47,9 @@ geometry::TriangleMesh tilted_ellipsoid(double theta, const Vec<3>& c) {
 TEST(CapsuleTrack3d, SectionInclinationThroughTheCentroid) {
   const Vec<3> c(3.0, 2.5, 2.0);
   const auto mesh = tilted_ellipsoid(0.4, c);
-  const membrane::FemMembrane fem(mesh, membrane::NeoHookean{1.0});
   const Capsule<3> capsule("cell", mesh.nodes, std::make_unique<membrane::FemMembrane>(mesh, membrane::NeoHookean{1.0}),
                            ibm::Transfer<3, ibm::Cosine4>());
-  const CapsuleTrack<3> track(capsule, fem, true);
+  const CapsuleTrack<3> track(capsule, static_cast<const membrane::FemMembrane&>(capsule.membrane()), true);
   // An ellipsoid's central section in x-z is the ellipse of its x-z semi-axes: same angle.
   EXPECT_NEAR(track.value("section_inclination", capsule, 1.0), 0.4, 1e-12);
   EXPECT_NEAR(track.value("inclination", capsule, 1.0), 0.4, 1e-12);
