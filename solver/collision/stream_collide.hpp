@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <span>
+#include <vector>
 
 #include "collision/equilibrium.hpp"
 #include "collision/operators.hpp"
@@ -168,14 +169,87 @@ template <int W, class Body>
   }
 }
 
-/// Redoes the collide-and-push of the interior nodes `nodes` (distinct linear indices) with Guo
-/// forcing, after stream_collide<false> of the whole block: every slot of next() receives from
-/// exactly one node, so overwriting the pushes of the forced nodes gives
-/// the forced step there and the unforced one (force zero) elsewhere. This keeps the forced
-/// kernel, about twice the cost per node, to the immersed boundary's stencils.
+/// Consecutive linear indices [begin, end) inside one row's interior, at least one chunk long.
+struct NodeSpan {
+  std::ptrdiff_t begin, end;
+};
+
+/// The nodes a forcing stage visits: distinct interior nodes in memory order and, where the
+/// block's rows are at least a vector chunk long, the spans that cover them (cover_with_spans).
+struct ForcedRegion {
+  std::span<const std::ptrdiff_t> nodes;
+  std::span<const NodeSpan> spans;
+  bool empty() const { return nodes.empty(); }
+};
+
+/// Covers the sorted distinct interior nodes `nodes` of grid g with spans of at least W nodes,
+/// so that a stage over them runs as contiguous vector code, not gathers and scatters (the
+/// union of the IB stencils is mostly short stretches of rows: the gathers and scatters of the
+/// forced collision cost it 18 % of a chapter 6 biconcave step, solver/bench/NOTES.md).
+/// Nodes of one row less than 2W apart share a span (the nodes between are visited too); a
+/// span shorter than W grows to W inside its row, backwards at the row's end. Spans are
+/// disjoint: two spans of one row are at least 2W − 1 apart before growing and each grows by
+/// less than W. Leaves `spans` empty when the rows are shorter than W.
+template <int D>
+void cover_with_spans(const field::Grid<D>& g, int W, std::span<const std::ptrdiff_t> nodes,
+                      std::vector<NodeSpan>& spans) {
+  spans.clear();
+  const int nx = g.n()[0];
+  if (nx < W) return;
+  const std::ptrdiff_t row = g.stride(1);  // index(x, ...) = x + 1 + (multiples of row)
+  for (std::size_t k = 0; k < nodes.size();) {
+    std::ptrdiff_t begin = nodes[k];
+    const std::ptrdiff_t row_lo = begin - begin % row + 1, row_hi = row_lo + nx;
+    std::ptrdiff_t end = begin + 1;
+    for (++k; k < nodes.size() && nodes[k] < row_hi && nodes[k] - end < 2 * W; ++k) end = nodes[k] + 1;
+    if (end - begin < W) {
+      begin = std::min(begin, row_hi - W);
+      end = begin + W;
+    }
+    spans.push_back({begin, end});
+  }
+}
+
+/// Runs body(n) for every node n of the spans: each span as whole chunks of W consecutive
+/// nodes, one `omp simd` loop each, the last shifted back to end at the span's end (it redoes
+/// nodes, so body(n) must write the same values each time and nothing another node reads);
+/// the spans in parallel (they are disjoint).
+template <int W, class Body>
+[[gnu::always_inline]] inline void for_each_in_spans(std::span<const NodeSpan> spans, const Body& body) {
+  const auto count = static_cast<std::ptrdiff_t>(spans.size());
+#pragma omp parallel for schedule(static) if (count > 64)
+  for (std::ptrdiff_t s = 0; s < count; ++s) {
+    const NodeSpan span = spans[s];
+    for (std::ptrdiff_t c0 = span.begin; c0 < span.end; c0 += W) {
+      const std::ptrdiff_t c = std::min(c0, span.end - W);
+#pragma omp simd
+      for (int j = 0; j < W; ++j) body(c + j);
+    }
+  }
+}
+
+/// body(n) for the nodes of `region`: over its spans where it has them, otherwise over the node
+/// list (for_each_in_chunks, gathers and scatters).
+template <int W, class Body>
+[[gnu::always_inline]] inline void for_each_forced_node(const ForcedRegion& region, const Body& body) {
+  if (!region.spans.empty()) {
+    for_each_in_spans<W>(region.spans, body);
+    return;
+  }
+  const std::ptrdiff_t* node = region.nodes.data();
+  auto listed = [&](std::ptrdiff_t k) __attribute__((always_inline)) { body(node[k]); };
+  for_each_in_chunks<W>(static_cast<std::ptrdiff_t>(region.nodes.size()), listed);
+}
+
+/// Redoes the collide-and-push of the nodes of `region` with Guo forcing, after
+/// stream_collide<false> of the whole block: every slot of next() receives from exactly one
+/// node, so overwriting the pushes of these nodes gives the forced step there and the unforced
+/// one elsewhere. The force must be zero off region.nodes (the nodes between them that its
+/// spans visit take the forced update with zero force: the unforced one up to round-off).
+/// This keeps the forced kernel, about twice the cost per node, to the IB's stencils.
 template <class L, class T, class Op>
 void collide_forced_at(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>& force,
-                       std::span<const std::ptrdiff_t> nodes) {
+                       const ForcedRegion& region) {
   constexpr int Q = L::q, D = L::d;
   const auto& g = pop.grid();
   const std::ptrdiff_t N = g.size();
@@ -185,36 +259,33 @@ void collide_forced_at(field::Populations<L, T>& pop, const Op& op, const field:
   T* dst = pop.next();
   const double* fp[D];
   for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data();
-  const std::ptrdiff_t* node = nodes.data();
   // The nodes are distinct, so no two lanes write one slot.
-  auto body = [=](std::ptrdiff_t k) __attribute__((always_inline)) {
-    update_node<true, L, T>(src, dst, N, off, op, fp, node[k]);
+  auto body = [=](std::ptrdiff_t n) __attribute__((always_inline)) {
+    update_node<true, L, T>(src, dst, N, off, op, fp, n);
   };
-  for_each_in_chunks<simd_chunk<T>>(static_cast<std::ptrdiff_t>(nodes.size()), body);
+  for_each_forced_node<simd_chunk<T>>(region, body);
 }
 
-/// u + F/(2ρ) at the distinct interior nodes `nodes` into `u` (same linear indices): the
-/// velocity of the forced collision (thesis eq. 2.25), which the markers move with. In double,
-/// as node_moments; vector code over the node list as collide_forced_at.
+/// u + F/(2ρ) into `u` at the nodes of `region` (same linear indices; the nodes between them
+/// that its spans visit too): the velocity of the forced collision (thesis eq. 2.25), which
+/// the markers move with. In double, as node_moments; vector code as collide_forced_at.
 template <class L, class T>
 void forced_velocity_at(const field::Populations<L, T>& pop, const field::VectorField<L::d, double>& force,
-                        std::span<const std::ptrdiff_t> nodes, field::VectorField<L::d, double>& u) {
+                        const ForcedRegion& region, field::VectorField<L::d, double>& u) {
   constexpr int Q = L::q, D = L::d;
   const std::ptrdiff_t N = pop.grid().size();
   const T* src = pop.current();
   const double* fp[D];
   double* up[D];
   for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data(), up[a] = u.comp[a].data();
-  const std::ptrdiff_t* node = nodes.data();
-  auto body = [=](std::ptrdiff_t k) __attribute__((always_inline)) {
-    const std::ptrdiff_t n = node[k];
+  auto body = [=](std::ptrdiff_t n) __attribute__((always_inline)) {
     double f[Q], rho, v[D];
 #pragma GCC unroll 19
     for (int i = 0; i < Q; ++i) f[i] = src[i * N + n];
     moments<L, double>(f, rho, v);
     for (int a = 0; a < D; ++a) up[a][n] = v[a] + fp[a][n] / (2.0 * rho);
   };
-  for_each_in_chunks<simd_chunk<T>>(static_cast<std::ptrdiff_t>(nodes.size()), body);
+  for_each_forced_node<simd_chunk<T>>(region, body);
 }
 
 /// Sets every interior node to the equilibrium of (ρ, u(x)) given by init(Index) -> (ρ, Vec).

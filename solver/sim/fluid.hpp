@@ -30,9 +30,9 @@ class Fluid {
   /// field now differs from the uniform body force (empty: none). The field holds the uniform
   /// body force everywhere except at the nodes the hook changed in its previous call, which
   /// the hook restores first: the IB touches only its stencils, so nothing here sweeps the
-  /// whole field every substep. Without a uniform body force only the returned nodes take the
-  /// forced kernel (collide_forced_at); with one, the whole block does.
-  using ForcingHook = std::function<std::span<const std::ptrdiff_t>(const Pop&, Force&)>;
+  /// whole field every substep. Without a uniform body force only the returned region takes
+  /// the forced kernel (collide_forced_at); with one, the whole block does.
+  using ForcingHook = std::function<collision::ForcedRegion(const Pop&, Force&)>;
 
   struct Block {
     Pop pop;
@@ -142,19 +142,19 @@ class Fluid {
   template <class Boundaries>
   void advance_block(Block& blk, const ForcingHook& hook, Boundaries&& apply_boundaries) {
     const std::size_t b = &blk - blocks_.data();
-    std::span<const std::ptrdiff_t> forced_nodes;
+    collision::ForcedRegion forced;
     if (hook) {
       if (blk.force.comp[0].empty()) {  // once: a hook on a block built without a force field
         blk.force = Force(blk.pop.grid().size());
         for (int a = 0; a < D; ++a) std::fill(blk.force.comp[a].begin(), blk.force.comp[a].end(), body_force_[b][a]);
       }
-      forced_nodes = hook(blk.pop, blk.force);
+      forced = hook(blk.pop, blk.force);
     }
     if (blk.has_body_force) {
       collision::stream_collide<true>(blk.pop, blk.op, &blk.force);
     } else {
       collision::stream_collide<false>(blk.pop, blk.op);
-      if (!forced_nodes.empty()) collision::collide_forced_at(blk.pop, blk.op, blk.force, forced_nodes);
+      if (!forced.empty()) collision::collide_forced_at(blk.pop, blk.op, blk.force, forced);
     }
     apply_boundaries();
     blk.pop.swap();

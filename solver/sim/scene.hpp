@@ -478,16 +478,16 @@ class Scene {
 
   /// The IB stage of one finest-block step: adds the bodies' force density to f.
   /// Returns the nodes where it wrote a force (the union of the stencils, see ForcingHook).
-  std::span<const std::ptrdiff_t> apply_ib(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
+  collision::ForcedRegion apply_ib(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
     if (bodies_.empty() && capsules_.empty()) return {};
     core::timed(seconds_ib_, [&] { restore_forced_nodes(f); });
     if (!bodies_.empty()) core::timed(seconds_ib_, [&] { force_bodies(pop, f); });
     if (!capsules_.empty()) move_capsules(pop, f);
     core::timed(seconds_ib_, [&] {
-      if (capsules_.empty()) collect_forced_nodes(pop.grid().size());  // move_capsules collected them
+      if (capsules_.empty()) collect_forced_nodes(pop.grid());  // move_capsules collected them
     });
     ++fine_steps_;
-    return forced_nodes_;
+    return forced_region();
   }
 
   /// Sets the nodes the IB wrote last step (forced_nodes_, each once) back to the uniform body
@@ -501,18 +501,21 @@ class Scene {
   }
 
   /// forced_nodes_ = the union of the current stencils of all bodies and capsules, each node
-  /// once and in memory order (ibm::StencilUnion).
+  /// once and in memory order (ibm::StencilUnion), and forced_spans_ the row spans that cover
+  /// it (collision::cover_with_spans), which the forced collision and velocity walk.
   /// Memory order lets the forced collision and the velocity gather walk the block's rows
   /// instead of jumping between the rows of each stencil (measured: unsorted, the forced
   /// collision of a 3D capsule's ~10k stencil nodes cost five unforced updates per node).
-  void collect_forced_nodes(std::ptrdiff_t grid_size) {
-    stencil_union_.begin(grid_size);
+  void collect_forced_nodes(const field::Grid<D>& grid) {
+    stencil_union_.begin(grid.size());
     for (const auto& b : bodies_)
       std::visit([&](const auto& forcing) { forcing.transfer().mark_stencil_nodes(stencil_union_); }, b.forcing);
     for (const auto& c : capsules_) c.mark_stencil_nodes(stencil_union_);
     forced_nodes_.clear();
     stencil_union_.collect(forced_nodes_);
+    collision::cover_with_spans(grid, collision::simd_chunk<T>, forced_nodes_, forced_spans_);
   }
+  collision::ForcedRegion forced_region() const { return {forced_nodes_, forced_spans_}; }
 
   /// Membrane forces, spreading, and the markers' move with the forced velocity (capsule.hpp).
   void move_capsules(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
@@ -522,12 +525,12 @@ class Scene {
     core::timed(seconds_ib_, [&] {
       for (auto& c : capsules_) guarded(c, [&] { c.spread(pop.grid(), periodic_, f); });
       // The velocity the forced collision uses, once per stencil node (stencils overlap).
-      collect_forced_nodes(pop.grid().size());
+      collect_forced_nodes(pop.grid());
       // Written into a block-sized field (only at the stencil nodes, which are all the
       // interpolation reads), so that the interpolation reads rows of consecutive nodes.
       if (static_cast<std::ptrdiff_t>(forced_velocity_.comp[0].size()) != pop.grid().size())
         forced_velocity_ = field::VectorField<D>(pop.grid().size());
-      collision::forced_velocity_at<L, T>(pop, f, forced_nodes_, forced_velocity_);
+      collision::forced_velocity_at<L, T>(pop, f, forced_region(), forced_velocity_);
       for (auto& c : capsules_) c.advect(forced_velocity_, pop.grid().dx());
     });
   }
@@ -1015,6 +1018,7 @@ class Scene {
   // The union of the IB stencils of the current step (collect_forced_nodes) and, for capsules,
   // the forced velocity at those nodes; buffers only grow.
   std::vector<std::ptrdiff_t> forced_nodes_;
+  std::vector<collision::NodeSpan> forced_spans_;
   ibm::StencilUnion stencil_union_;
   // u* + f / (2 rho) at forced_nodes_ (stale elsewhere): D doubles per node of the finest
   // block, for interpolation by rows (24 bytes per 3D node, against 152 for the two buffers of

@@ -305,12 +305,15 @@ TYPED_TEST(StreamingTest, PeriodicStreamMovesEveryPopulationByItsVelocity) {
   }
 }
 
-TYPED_TEST(StreamingTest, ForcedCollisionAtNodesEqualsTheForcedKernel) {
-  // stream_collide<false> then collide_forced_at(nodes) must give what the forced kernel gives
-  // over the whole block with the force zero off those nodes; over 256 distinct nodes, not a
-  // multiple of the vector chunk (the parallel chunks and the shifted tail).
-  using L = typename TypeParam::L;
-  using T = typename TypeParam::T;
+// stream_collide<false> then collide_forced_at(region) must give what the forced kernel gives
+// over the whole block with the force zero off the region's nodes, whether the region is walked
+// by its node list (gathers, scatters) or by the spans that cover it (which also visit nodes
+// between, with zero force); `density` of the interior nodes forced: 0.7 gives over 256 nodes,
+// not a multiple of the vector chunk (the parallel chunks and the shifted tail), 0.04 gives
+// isolated nodes whose spans grow, backwards at the rows' ends. The forced velocity at the
+// nodes is u + F/(2 rho) of the same populations.
+template <class L, class T>
+void check_forced_collision_at_nodes(double density, bool spans) {
   constexpr int D = L::d, Q = L::q;
   Index<D> n;
   if constexpr (D == 2)
@@ -319,13 +322,13 @@ TYPED_TEST(StreamingTest, ForcedCollisionAtNodesEqualsTheForcedKernel) {
     n = {simd_chunk<T> + 3, 8, 7};
   const field::Grid<D> g(n, Vec<D>::Zero(), 1.0);
   field::Populations<L, T> a(g), b(g);
-  field::VectorField<D, double> force(g.size());
+  field::VectorField<D, double> force(g.size()), u(g.size());
   std::vector<std::ptrdiff_t> nodes;
   std::mt19937 rng(5);
   field::for_each_interior<D>(g, [&](const Index<D>& x) {
     const auto id = g.index(x);
     for (int i = 0; i < Q; ++i) a(i, id) = b(i, id) = T(uniform(rng, -0.05, 0.05));
-    if (uniform(rng, 0.0, 1.0) < 0.7) {
+    if (uniform(rng, 0.0, 1.0) < density) {
       nodes.push_back(id);
       for (int c = 0; c < D; ++c) force.comp[c][id] = uniform(rng, -1e-3, 1e-3);
     }
@@ -334,11 +337,26 @@ TYPED_TEST(StreamingTest, ForcedCollisionAtNodesEqualsTheForcedKernel) {
     for (int c = 0; c < D; ++c) force.comp[c][nodes.back()] = 0.0;
     nodes.pop_back();
   }
-  ASSERT_GT(nodes.size(), 256u);
+  ASSERT_GT(nodes.size(), density > 0.5 ? 256u : 8u);
+  std::vector<NodeSpan> cover;
+  if (spans) {
+    cover_with_spans(g, simd_chunk<T>, nodes, cover);
+    ASSERT_FALSE(cover.empty());
+  }
+  const ForcedRegion region{nodes, cover};
   const Trt op{0.8, 0.25};
+  forced_velocity_at(b, force, region, u);
+  for (const auto id : nodes) {
+    T f[Q];
+    for (int i = 0; i < Q; ++i) f[i] = b(i, id);
+    T F[D], rho, v[D];
+    for (int c = 0; c < D; ++c) F[c] = T(force.comp[c][id]);
+    moments<L, T>(f, F, rho, v);
+    for (int c = 0; c < D; ++c) ASSERT_NEAR(u.comp[c][id], v[c], 1e-6) << "node " << id;
+  }
   stream_collide<true>(a, op, &force);
   stream_collide<false>(b, op);
-  collide_forced_at(b, op, force, nodes);
+  collide_forced_at(b, op, force, region);
   const double tol = std::is_same_v<T, float> ? 1e-7 : 1e-16;
   int mismatches = 0;
   field::for_each_interior<D>(g, [&](const Index<D>& x) {
@@ -349,7 +367,45 @@ TYPED_TEST(StreamingTest, ForcedCollisionAtNodesEqualsTheForcedKernel) {
                       << ", forced at nodes " << b.next()[slot];
     }
   });
-  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(mismatches, 0) << "density " << density << (spans ? ", spans" : ", node list");
+}
+
+TYPED_TEST(StreamingTest, ForcedCollisionAtNodesEqualsTheForcedKernel) {
+  using L = typename TypeParam::L;
+  using T = typename TypeParam::T;
+  for (const double density : {0.7, 0.04})
+    for (const bool spans : {false, true}) check_forced_collision_at_nodes<L, T>(density, spans);
+}
+
+TEST(CoverWithSpans, SpansAreDisjointRowStretchesOfWholeChunksThatCoverEveryNode) {
+  // Nodes at the start, middle and end of rows; neighbours closer than 2W merge.
+  constexpr int W = 4;
+  const field::Grid<3> g({30, 4, 3}, Vec<3>::Zero(), 1.0);
+  auto at = [&](int x, int y, int z) { return g.index({x, y, z}); };
+  const std::vector<std::ptrdiff_t> nodes{at(0, 1, 1),  at(1, 1, 1), at(5, 1, 1),  // one span [0, 6)
+                                          at(20, 1, 1), at(27, 1, 1),              // [20, 28)
+                                          at(0, 2, 1),  at(29, 2, 1),              // [0, 4), [26, 30)
+                                          at(28, 3, 2)};                           // grows backwards
+  std::vector<NodeSpan> spans;
+  cover_with_spans(g, W, nodes, spans);
+  ASSERT_EQ(spans.size(), 5u);
+  const std::ptrdiff_t expected[5][2] = {{at(0, 1, 1), at(6, 1, 1)},
+                                         {at(20, 1, 1), at(28, 1, 1)},
+                                         {at(0, 2, 1), at(4, 2, 1)},
+                                         {at(26, 2, 1), at(29, 2, 1) + 1},
+                                         {at(26, 3, 2), at(29, 3, 2) + 1}};
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_EQ(spans[k].begin, expected[k][0]) << "span " << k;
+    EXPECT_EQ(spans[k].end, expected[k][1]) << "span " << k;
+  }
+  for (std::size_t k = 0; k < spans.size(); ++k) {
+    EXPECT_GE(spans[k].end - spans[k].begin, W);
+    if (k > 0) EXPECT_GE(spans[k].begin, spans[k - 1].end);
+  }
+  // Rows shorter than a chunk: no spans (the caller walks the node list).
+  const field::Grid<3> narrow({W - 1, 4, 3}, Vec<3>::Zero(), 1.0);
+  cover_with_spans(narrow, W, std::vector<std::ptrdiff_t>{narrow.index({2, 1, 1})}, spans);
+  EXPECT_TRUE(spans.empty());
 }
 
 // ---------------------------------------------------------------------------------------
