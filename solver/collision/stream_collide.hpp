@@ -189,10 +189,11 @@ struct ForcedRegion {
 /// Nodes of one row less than 2W apart share a span (the nodes between are visited too); a
 /// span shorter than W grows to W inside its row, backwards at the row's end. Spans are
 /// disjoint: two spans of one row are at least 2W − 1 apart before growing and each grows by
-/// less than W. Leaves `spans` empty when the rows are shorter than W.
-template <int D>
-void cover_with_spans(const field::Grid<D>& g, int W, std::span<const std::ptrdiff_t> nodes,
-                      std::vector<NodeSpan>& spans) {
+/// less than W. Leaves `spans` empty when the rows are shorter than W. W is the walker's chunk
+/// (for_each_in_spans<W>, a span shorter than it would be overrun): both take it at compile
+/// time, simd_chunk<T> of the populations.
+template <int W, int D>
+void cover_with_spans(const field::Grid<D>& g, std::span<const std::ptrdiff_t> nodes, std::vector<NodeSpan>& spans) {
   spans.clear();
   const int nx = g.n()[0];
   if (nx < W) return;
@@ -210,10 +211,10 @@ void cover_with_spans(const field::Grid<D>& g, int W, std::span<const std::ptrdi
   }
 }
 
-/// Runs body(n) for every node n of the spans: each span as whole chunks of W consecutive
-/// nodes, one `omp simd` loop each, the last shifted back to end at the span's end (it redoes
-/// nodes, so body(n) must write the same values each time and nothing another node reads);
-/// the spans in parallel (they are disjoint).
+/// Runs body(n) for every node n of the spans (cover_with_spans<W>): each span as whole chunks
+/// of W consecutive nodes, one `omp simd` loop each, the last shifted back to end at the span's
+/// end (it redoes nodes, so body(n) must write the same values each time and nothing another
+/// node reads); the spans in parallel (they are disjoint).
 template <int W, class Body>
 [[gnu::always_inline]] inline void for_each_in_spans(std::span<const NodeSpan> spans, const Body& body) {
   const auto count = static_cast<std::ptrdiff_t>(spans.size());

@@ -513,7 +513,7 @@ class Scene {
     for (const auto& c : capsules_) c.mark_stencil_nodes(stencil_union_);
     forced_nodes_.clear();
     stencil_union_.collect(forced_nodes_);
-    collision::cover_with_spans(grid, collision::simd_chunk<T>, forced_nodes_, forced_spans_);
+    collision::cover_with_spans<collision::simd_chunk<T>>(grid, forced_nodes_, forced_spans_);
   }
   collision::ForcedRegion forced_region() const { return {forced_nodes_, forced_spans_}; }
 
