@@ -22,17 +22,23 @@
 //     index, weight w0 w1 [w2]) are formed where they are used (for_each_stencil_node).
 //     Storing the expanded entries (64 x 28 bytes per 3D marker) made update() a wall of
 //     stores and cost as much as spreading (solver/bench/NOTES.md).
-//   * Threads: update(), interpolation and mark_stencil_nodes() run in parallel over markers
+//   * Threads: update() and interpolation run in parallel over markers
 //     (OpenMP, for large marker counts); the callables passed to interpolate must be safe to call
-//     concurrently and must not throw. Spreading runs in parallel over slabs: spread()
-//     first sorts the markers (stably) by the slab of `support` nodes along the last axis in
-//     which their stencil starts. A node is reached from at most two consecutive slabs, so
-//     the even slabs can spread at once, then the odd ones; each node then sums its
-//     contributions in the same order (even slab, then odd, markers in index order within
-//     a slab) whatever the thread count: bit-reproducible without locks. Along a periodic
-//     last axis a stencil may wrap onto the first slab, and the spread is serial, slab by
-//     slab (markers in index order within a slab).
+//     concurrently and must not throw. Spreading runs in parallel over ranges of planes (the
+//     node index along the last axis): update() sorts the markers (stably) by the plane in
+//     which their stencil starts; each thread owns a contiguous range of planes, chosen so
+//     that the ranges hold about equally many stencil rows, and adds, marker by marker in the
+//     sorted order, the rows of each stencil that lie in its planes. A node in plane p thus sums
+//     its contributions by starting plane (p − support + 1 … p), markers in index order within
+//     one, whatever the thread count: bit-reproducible without locks, and balanced however the
+//     markers are distributed (solver/bench/NOTES.md: even and odd slabs of `support` planes in
+//     two passes balanced worse). Marking
+//     the stencil nodes (mark_stencil_nodes) splits the planes the same way, so that two threads
+//     never store to one cache line of the masks. Along a periodic last axis a stencil may wrap
+//     onto the first planes, and both are serial.
 #pragma once
+
+#include <omp.h>
 
 #include <algorithm>
 #include <array>
@@ -94,6 +100,7 @@ class Transfer {
     if (first_bad < m_count)
       core::check_failed("stencil inside block", __FILE__, __LINE__,
                          stencil_error(first_bad, positions[first_bad]));
+    sort_by_plane();
   }
 
   std::size_t marker_count() const { return x_lu_.size(); }
@@ -121,31 +128,23 @@ class Transfer {
     }
   }
 
-  /// Marks every stencil node of every marker in `nodes` (in parallel for many markers): a
+  /// Marks every stencil node of every marker in `nodes` (in parallel over ranges of planes, as
+  /// spread(): two threads never mark one plane, so they do not write the same cache lines): a
   /// row along axis 0 at once where it is `support` consecutive nodes, else node by node.
   void mark_stencil_nodes(StencilUnion& nodes) const {
-    const std::ptrdiff_t m_count = static_cast<std::ptrdiff_t>(marker_count());
+    if (marker_count() == 0) return;
     const bool rows = nodes.runs_of(support);
-    std::ptrdiff_t lo = std::numeric_limits<std::ptrdiff_t>::max(), hi = -1;
-#pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold) \
-    reduction(min : lo) reduction(max : hi)
-    for (std::ptrdiff_t m = 0; m < m_count; ++m) {
+    for_each_marker_by_planes([&](std::size_t m, int lo, int hi) {
       const Stencil& s = stencil_[m];
-      if (rows && s.rows) {
-        for_each_stencil_row(m,
-                             [&](std::ptrdiff_t first, const double(&)[support]) { nodes.mark_run(first); });
-      } else {
-        for_each_stencil_node(m, [&](const Index<D>&, std::ptrdiff_t n, double) { nodes.mark_node(n); });
-      }
-      std::ptrdiff_t first = 0, last = 0;
-      for (int a = 0; a < D; ++a) {
-        first += *std::min_element(std::begin(s.off[a]), std::end(s.off[a]));
-        last += *std::max_element(std::begin(s.off[a]), std::end(s.off[a]));
-      }
-      lo = std::min(lo, first);
-      hi = std::max(hi, last);
-    }
-    if (m_count > 0) nodes.widen(lo, hi);
+      for_each_row_in_planes(m, lo, hi, [&](std::ptrdiff_t rest, const double(&)[support]) {
+        if (rows && s.rows)
+          nodes.mark_run(s.off[0][0] + rest);
+        else
+          for (int i = 0; i < support; ++i) nodes.mark_node(s.off[0][i] + rest);
+      });
+    });
+    const std::ptrdiff_t plane = grid_.stride(D - 1);  // the planes' linear indices: from (p + 1) * plane
+    nodes.widen((plane_lo_ + 1) * plane, (plane_hi_ + 2) * plane - 1);
   }
 
   /// out[m] = sum_x u(x) phi(x - X_m) (eq. 2.19 / 5.11), with
@@ -194,45 +193,29 @@ class Transfer {
 
   /// f(x) += sum_m force_density[m] weight_lu[m] phi(x - X_m) (eq. 2.16 / 5.8), with the
   /// force per unit marker measure and the marker measure in lattice units. In parallel over
-  /// slabs, in an order that does not depend on the thread count (see the file header).
-  /// (Not const: it sorts the markers into slabs first, which only spreading needs; direct
-  /// forcing of rigid bodies updates stencils every step but spreads through its own copy.)
+  /// ranges of planes, in an order that does not depend on the thread count (see the file
+  /// header).
   void spread(std::span<const Vec<D>> force_density, std::span<const double> weight_lu,
-              field::VectorField<D>& f) {
+              field::VectorField<D>& f) const {
     CAPLAB_CHECK(force_density.size() == marker_count() && weight_lu.size() == marker_count(),
                  "IB spread: need one force density and one weight per marker (as in the last update)");
     CAPLAB_CHECK(static_cast<std::ptrdiff_t>(f.comp[0].size()) == grid_.size(),
                  "IB spread: the force field is not sized for the grid of the last update");
-    sort_into_slabs();
-    auto spread_slab = [&](int slab) {
-      for (std::size_t k = slab_start_[slab]; k < slab_start_[slab + 1]; ++k) {
-        const std::size_t m = order_[k];
-        const Vec<D> fm = force_density[m] * weight_lu[m];
-        if (stencil_[m].rows) {  // rows of consecutive nodes: vector code, same sums as below
-          for_each_stencil_row(m, [&](std::ptrdiff_t first, const double(&w)[support]) {
-            for (int a = 0; a < D; ++a) {
-              double* __restrict__ row = f.comp[a].data() + first;
+    for_each_marker_by_planes([&](std::size_t m, int lo, int hi) {
+      const Vec<D> fm = force_density[m] * weight_lu[m];
+      const Stencil& s = stencil_[m];
+      for_each_row_in_planes(m, lo, hi, [&](std::ptrdiff_t rest, const double(&w)[support]) {
+        for (int a = 0; a < D; ++a) {
+          if (s.rows) {  // rows of consecutive nodes: vector code, the same sums
+            double* __restrict__ row = f.comp[a].data() + s.off[0][0] + rest;
 #pragma omp simd
-              for (int i = 0; i < support; ++i) row[i] += w[i] * fm[a];
-            }
-          });
-        } else {
-          for_each_stencil_node(m, [&](const Index<D>&, std::ptrdiff_t id, double w) {
-            for (int a = 0; a < D; ++a) f.comp[a][id] += w * fm[a];
-          });
+            for (int i = 0; i < support; ++i) row[i] += w[i] * fm[a];
+          } else {
+            for (int i = 0; i < support; ++i) f.comp[a][s.off[0][i] + rest] += w[i] * fm[a];
+          }
         }
-      }
-    };
-    const int slabs = slab_count();
-    if (periodic_[D - 1]) {
-      for (int slab = 0; slab < slabs; ++slab) spread_slab(slab);
-      return;
-    }
-    const bool parallel = static_cast<std::ptrdiff_t>(marker_count()) > detail::parallel_threshold;
-    for (int parity = 0; parity < 2; ++parity) {
-#pragma omp parallel for schedule(dynamic, 1) if (parallel)
-      for (int slab = parity; slab < slabs; slab += 2) spread_slab(slab);
-    }
+      });
+    });
   }
 
  private:
@@ -324,23 +307,82 @@ class Transfer {
     return true;
   }
 
-  // Slabs of `support` nodes along the last axis; a stencil starting in slab k reaches slab k + 1
-  // at most (support - 1 nodes further), never k + 2.
-  int slab_count() const { return grid_.n()[D - 1] / support + 1; }
+  // Calls f(rest, w) for the rows along axis 0 of marker m's stencil whose plane (index along
+  // the last axis) lies in [lo, hi): the nodes s.off[0][i] + rest with the weights w[i],
+  // i < support (the products of for_each_stencil_node, in its order).
+  template <class F>
+  void for_each_row_in_planes(std::size_t m, int lo, int hi, F&& f) const {
+    const Stencil& s = stencil_[m];
+    double w[support];
+    for (int k = 0; k < support; ++k) {
+      const int plane = s.i[D - 1][k];
+      if (plane < lo || plane >= hi) continue;
+      if constexpr (D == 2) {
+        for (int i = 0; i < support; ++i) w[i] = s.w[0][i] * s.w[1][k];
+        f(s.off[1][k], w);
+      } else {
+        for (int j = 0; j < support; ++j) {
+          for (int i = 0; i < support; ++i) w[i] = s.w[0][i] * s.w[1][j] * s.w[2][k];
+          f(s.off[1][j] + s.off[2][k], w);
+        }
+      }
+    }
+  }
 
-  // order_ = the markers sorted stably by the slab of their first stencil node along the last
-  // axis (a counting sort); slab k holds order_[slab_start_[k] .. slab_start_[k + 1]).
-  void sort_into_slabs() {
-    const int slabs = slab_count();
+  // Calls body(m, lo, hi) for the markers whose stencils reach planes [lo, hi), in the order of
+  // sort_by_plane, each thread for its own range of planes: contiguous ranges holding about
+  // equally many stencil planes. A node in plane p is thus reached by markers in the same
+  // order whatever the thread count (see the file header). One range, serial, along a
+  // periodic last axis (stencils wrap) or for few markers.
+  template <class Body>
+  void for_each_marker_by_planes(Body&& body) const {
+    const int n = grid_.n()[D - 1];
+    auto run = [&](int first, int lo, int hi) {  // the markers starting in [first, hi)
+      for (std::size_t k = plane_start_[first]; k < plane_start_[hi]; ++k) body(order_[k], lo, hi);
+    };
+    if (periodic_[D - 1] || static_cast<std::ptrdiff_t>(marker_count()) <= detail::parallel_threshold) {
+      run(0, 0, n);
+      return;
+    }
+#pragma omp parallel
+    {
+      const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+      auto split = [&](int k) {  // the first plane of thread k's range
+        if (k == 0 || k == threads) return k == 0 ? 0 : n;
+        const std::size_t share = (plane_load_[n] * k + threads - 1) / threads;
+        return static_cast<int>(std::lower_bound(plane_load_.begin(), plane_load_.end(), share) -
+                                plane_load_.begin());
+      };
+      const int lo = split(t), hi = split(t + 1);
+      if (lo < hi) run(std::max(0, lo - support + 1), lo, hi);
+    }
+  }
+
+  // order_ = the markers sorted stably by the plane of their first stencil node along the last
+  // axis (a counting sort); plane p holds order_[plane_start_[p] .. plane_start_[p + 1]).
+  void sort_by_plane() {
+    const int n = grid_.n()[D - 1];
     const std::size_t m_count = marker_count();
-    auto slab_of = [&](std::size_t m) { return stencil_[m].i[D - 1][0] / support; };
-    slab_start_.assign(slabs + 1, 0);
+    auto plane_of = [&](std::size_t m) { return stencil_[m].i[D - 1][0]; };
+    plane_start_.assign(n + 1, 0);
     order_.resize(m_count);
-    for (std::size_t m = 0; m < m_count; ++m) ++slab_start_[slab_of(m) + 1];
-    for (int k = 0; k < slabs; ++k) slab_start_[k + 1] += slab_start_[k];
-    for (std::size_t m = 0; m < m_count; ++m) order_[slab_start_[slab_of(m)]++] = m;
-    for (int k = slabs; k > 0; --k) slab_start_[k] = slab_start_[k - 1];  // undo the fill's advance
-    slab_start_[0] = 0;
+    for (std::size_t m = 0; m < m_count; ++m) ++plane_start_[plane_of(m) + 1];
+    for (int p = 0; p < n; ++p) plane_start_[p + 1] += plane_start_[p];
+    for (std::size_t m = 0; m < m_count; ++m) order_[plane_start_[plane_of(m)]++] = m;
+    for (int p = n; p > 0; --p) plane_start_[p] = plane_start_[p - 1];  // undo the fill's advance
+    plane_start_[0] = 0;
+    // plane_load_[p]: stencil planes (of `support` rows each) in the planes before p.
+    plane_load_.assign(n + 1, 0);
+    for (int p = 0; p < n; ++p)
+      plane_load_[p + 1] =
+          plane_load_[p] + (plane_start_[p + 1] - plane_start_[std::max(0, p - support + 1)]);
+    plane_lo_ = n;
+    plane_hi_ = -1;
+    for (std::size_t m = 0; m < m_count; ++m)
+      for (int k = 0; k < support; ++k) {
+        plane_lo_ = std::min(plane_lo_, stencil_[m].i[D - 1][k]);
+        plane_hi_ = std::max(plane_hi_, stencil_[m].i[D - 1][k]);
+      }
   }
 
   std::string stencil_error(std::ptrdiff_t m, const Vec<D>& x_phys) const {
@@ -383,7 +425,9 @@ class Transfer {
   std::array<bool, D> periodic_{};
   std::vector<Vec<D>> x_lu_;
   std::vector<Stencil> stencil_;
-  std::vector<std::size_t> slab_start_, order_;  // markers by slab (sort_into_slabs)
+  // The markers by the plane their stencil starts in, and what the threads split (sort_by_plane).
+  std::vector<std::size_t> plane_start_, order_, plane_load_;
+  int plane_lo_ = 0, plane_hi_ = -1;  // the planes the stencils reach
 };
 
 /// One-shot interpolation of velocity_at(const Index<D>&, std::ptrdiff_t) -> Vec<D> at the
