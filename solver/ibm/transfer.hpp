@@ -234,20 +234,9 @@ class Transfer {
   // products in the same order), rows in the order of for_each_stencil_node.
   template <class F>
   void for_each_stencil_row(std::size_t m, F&& f) const {
-    const Stencil& s = stencil_[m];
-    double w[support];
-    if constexpr (D == 2) {
-      for (int j = 0; j < support; ++j) {
-        for (int i = 0; i < support; ++i) w[i] = s.w[0][i] * s.w[1][j];
-        f(s.off[0][0] + s.off[1][j], w);
-      }
-    } else {
-      for (int k = 0; k < support; ++k)
-        for (int j = 0; j < support; ++j) {
-          for (int i = 0; i < support; ++i) w[i] = s.w[0][i] * s.w[1][j] * s.w[2][k];
-          f(s.off[0][0] + s.off[1][j] + s.off[2][k], w);
-        }
-    }
+    const std::ptrdiff_t first = stencil_[m].off[0][0];
+    for_each_row_in_planes(m, std::numeric_limits<int>::min(), std::numeric_limits<int>::max(),
+                           [&](std::ptrdiff_t rest, const double(&w)[support]) { f(first + rest, w); });
   }
 
   template <class T, class ValueAt>

@@ -170,10 +170,12 @@ TYPED_TEST(TransferTest, SpreadDoesNotDependOnTheThreadCount) {
   for (int threads : {2, 3, 7}) {
     const auto many = spread_with(threads);
     for (int a = 0; a < D; ++a)
-      for (std::ptrdiff_t n = 0; n < g.size(); ++n) ASSERT_EQ(one.comp[a][n], many.comp[a][n]) << threads << " threads, node " << n;
+      for (std::ptrdiff_t n = 0; n < g.size(); ++n)
+        ASSERT_EQ(one.comp[a][n], many.comp[a][n]) << threads << " threads, node " << n;
   }
   for (int a = 0; a < D; ++a)
-    for (std::ptrdiff_t n = 0; n < g.size(); ++n) ASSERT_NEAR(one.comp[a][n], serial.comp[a][n], 1e-12) << "node " << n;
+    for (std::ptrdiff_t n = 0; n < g.size(); ++n)
+      ASSERT_NEAR(one.comp[a][n], serial.comp[a][n], 1e-12) << "node " << n;
 }
 
 TYPED_TEST(TransferTest, FieldInterpolationEqualsTheCallableForm) {
