@@ -349,6 +349,32 @@ TEST(TransferMark, TheUnionIsExactlyTheStencilNodesInMemoryOrder) {
   EXPECT_EQ(collected_union(u, g.size(), r), stencil_node_set(g.size(), r));
 }
 
+TEST(TransferMark, TheUnionDoesNotDependOnTheThreadCount) {
+  // Above the parallel threshold and without a periodic last axis, marking splits the planes
+  // among the threads (for_each_marker_by_planes): on 1, 2, 3 and 7 threads (more threads than
+  // planes with markers in some ranges) the union is every stencil node once, rows that wrap
+  // around the periodic x included.
+  const auto g = make_grid<3>(16);
+  std::mt19937 rng(23);
+  auto x = random_positions<3>(g, 1500, 2.0, 13.0, rng);
+  for (int k = 0; k < 40; ++k) {  // stencil rows that wrap along x, at both ends
+    Vec<3> p = random_positions<3>(g, 1, 2.0, 13.0, rng)[0];
+    p[0] = g.origin()[0] + g.dx() * (k % 2 ? 0.3 : 15.6);
+    x.push_back(p);
+  }
+  ASSERT_GT(static_cast<std::ptrdiff_t>(x.size()), detail::parallel_threshold);
+  Transfer<3, Cosine4> t;
+  t.update(g, {true, false, false}, x);
+  const auto want = stencil_node_set(g.size(), t);
+  StencilUnion u;
+  const int saved = omp_get_max_threads();
+  for (int threads : {1, 2, 3, 7}) {
+    omp_set_num_threads(threads);
+    EXPECT_EQ(collected_union(u, g.size(), t), want) << threads << " threads";
+  }
+  omp_set_num_threads(saved);
+}
+
 TEST(TransferPeriodic, AxisShorterThanTheStencilWrapsEveryNode) {
   // A periodic axis of 2 nodes under a 4-node stencil: every node index wraps into 0..1, the
   // weights of the nodes that coincide add up (partition of unity), and the union holds them.
