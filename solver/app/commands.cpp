@@ -31,8 +31,13 @@ void print_units(const cases::CaseSpec& spec, const sim::LatticeUnits& u) {
   for (const auto& b : u.blocks) {
     std::string nodes;
     for (std::size_t a = 0; a < b.nodes.size(); ++a) nodes += (a ? " x " : "") + std::to_string(b.nodes[a]);
-    fmt::print("  block {:8s} dx = {:.5g} L, dt = {:.5g} L/U, tau = {:.5f}, nu_lu = {:.5g}, nodes {}\n", b.name, b.dx,
-               b.dt, b.tau, b.nu_lu, nodes);
+    // TRT: the odd moments' relaxation time too; far above 1 it lets interface and IB errors persist.
+    const auto& col = spec.numerics.collision;
+    const std::string tau_minus = col.op == cases::CollisionSpec::Operator::trt
+                                      ? fmt::format(" (tau- = {:.3g})", 0.5 + col.magic / (b.tau - 0.5))
+                                      : std::string();
+    fmt::print("  block {:8s} dx = {:.5g} L, dt = {:.5g} L/U, tau = {:.5f}{}, nu_lu = {:.5g}, nodes {}\n", b.name, b.dx,
+               b.dt, b.tau, tau_minus, b.nu_lu, nodes);
   }
 }
 

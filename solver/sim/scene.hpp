@@ -595,8 +595,10 @@ class Scene {
       } catch (const core::Error& e) {
         // The IB stage sees a diverged flow first (it checks every stencil node every step).
         throw core::NumericalError(step_, fmt::format("immersed boundary of body '{}'", b.name), e.what(),
-                                   "the flow diverged next to the body; see the guard message for the usual fixes "
-                                   "(TRT, a finer grid, a lower numerics.lattice_velocity, tau further from 1/2)");
+                                   "the flow diverged next to the body; the usual fixes move tau away from 1/2 "
+                                   "(a finer grid, or a higher numerics.lattice_velocity at the same Re as far as the "
+                                   "Mach number allows) or damp the odd moments (BGK: the TRT operator; TRT: a "
+                                   "smaller numerics.collision.magic)");
       }
     }
   }
@@ -746,10 +748,22 @@ class Scene {
                              "velocity raises it)",
                              b.name, E_lu, limit, D);
       }
-    if (tau < 0.55)
-      return fmt::format("tau = {:.4f} on this block is close to 1/2 for this Reynolds number and grid; use the TRT "
-                         "operator, refine the grid or lower numerics.lattice_velocity",
-                         tau);
+    if (tau < 0.55) {
+      // At a fixed Re and grid, tau - 1/2 = 3 U_lu (L/dx) / Re: a lower lattice velocity moves tau
+      // closer to 1/2, a higher one (Mach allowing) or a finer grid moves it away.
+      const auto& col = spec_.numerics.collision;
+      const std::string remedy =
+          col.op == cases::CollisionSpec::Operator::bgk
+              ? std::string("use the TRT operator (numerics.collision.operator = \"trt\")")
+              : fmt::format("with TRT the odd moments relax with tau- = 1/2 + magic / (tau - 1/2) = {:.3g}, slowly, "
+                            "and the errors the refinement interface or the immersed boundary put there persist: "
+                            "a smaller numerics.collision.magic ({:.3g} gives tau- = {:.3g})",
+                            0.5 + col.magic / (tau - 0.5), col.magic / 3, 0.5 + col.magic / 3 / (tau - 0.5));
+      return fmt::format("tau = {:.4f} on this block is close to 1/2 for this Reynolds number and grid; {}, a finer "
+                         "grid or a higher numerics.lattice_velocity (tau - 1/2 grows with it at a fixed Re, as far as "
+                         "the Mach number allows)",
+                         tau, remedy);
+    }
     return fmt::format("the lattice velocity {:.3g} is too high for this flow (compressibility): lower "
                        "numerics.lattice_velocity",
                        units_.velocity_lu);
