@@ -31,7 +31,7 @@ STEADY, SWINGING, TUMBLING = "steady_tank_treading", "oscillating_tank_treading"
 THESIS_U = 1e-4 / 2
 #: Standard: four times the thesis's lattice velocity (four times fewer steps), with TRT.
 STANDARD_U = 4 * THESIS_U
-THESIS_LEVEL = {"numerics.lattice_velocity": THESIS_U, "numerics.collision.operator": "bgk"}
+THESIS_LEVEL = {"numerics.lattice_velocity": THESIS_U, "numerics.collision": {"operator": "bgk"}}
 
 
 def tau(re, u, spacing):
@@ -39,6 +39,16 @@ def tau(re, u, spacing):
     with a = 1/spacing lattice units, tau = 1/2 + 3 nu. The fine block of the two-level grid runs at half the
     coarse time step with the same lattice velocity (acoustic scaling), so its tau is this with the fine spacing."""
     return 0.5 + 12 * u / (spacing * re)
+
+
+def thesis_magic(re, spacing):
+    """The TRT magic parameter of the quick and standard levels: Lambda = (tau_f - 1/2)^2 of the thesis's BGK run
+    on the fine block (spacing in a). BGK is TRT with Lambda = (tau - 1/2)^2, and at a fixed grid TRT's steady
+    solutions depend on Lambda alone, not on tau: so the standard level, at four times the thesis's lattice
+    velocity, keeps the thesis's steady-state discretization where the capsule is. It matters for the immersed
+    boundary's area leak, which grows with Lambda and not with tau (references/capsule2d/provenance.json,
+    ib_area_leak_and_magic)."""
+    return round((tau(re, THESIS_U, spacing) - 0.5) ** 2, 6)
 
 
 def mach(u, domain=16):
@@ -56,6 +66,7 @@ def setup(re, fine_spacing=0.05):
     def taus(u):
         return f"tau_c = {tau(re, u, 2 * h):.3g}, tau_f = {tau(re, u, h):.3g}"
 
+    magic = thesis_magic(re, h)
     return ("Liquid-filled 2D capsule with a Hookean membrane (thesis eq. 3.6) and bending moment m = E_B (kappa - "
             "kappa_0) (eq. 3.8) in unbounded simple shear u = (k y, 0) imposed on all four faces (non-equilibrium "
             f"extrapolation), domain 16a x 16a, capsule at the centre, fine block [5a, 11a]^2 with spacing {h:.3g}a, "
@@ -64,7 +75,10 @@ def setup(re, fine_spacing=0.05):
             "E_b = E_B/(a^2 E) (eq. 3.10). "
             f"Lattice velocity: the thesis uses 2ka = 1e-4 (k a = 5e-5, BGK; {taus(THESIS_U)} at this Re = {re:g} "
             f"and grid), kept by level thesis; standard uses k a = 2e-4 with TRT ({taus(STANDARD_U)}: four times "
-            f"fewer steps; the Mach number at the domain edge (8 k a) is {mach(STANDARD_U):.2g}), ")
+            f"fewer steps; the Mach number at the domain edge (8 k a) is {mach(STANDARD_U):.2g}) and the magic "
+            f"parameter of the thesis's BGK on the fine block, (tau_f - 1/2)^2 = {magic:g} (TRT's steady solutions "
+            "depend on it alone at a fixed grid; with 1/4 the immersed boundary's area leak was 1.6 times the "
+            "thesis level's, references/capsule2d/provenance.json), ")
 
 
 QUICK_HALF = "quick doubles the spacing and the lattice velocity and halves the membrane nodes."
@@ -150,7 +164,8 @@ def case(cid, title, description, *, shape, G, re, end_time, average_from, Eb=0.
         },
         "numerics": {
             "grid": grid,
-            "collision": {"operator": "trt"},
+            "collision": ({"operator": "trt", "magic": thesis_magic(re, fine_spacing)} if thesis == THESIS_LEVEL
+                          else {"operator": "trt"}),
             "precision": "double",
             "ib": {"kernel": "cosine4"},
             "lattice_velocity": u,
