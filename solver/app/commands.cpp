@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "case/load_case.hpp"
+#include "collision/operators.hpp"
 #include "core/error.hpp"
 #include "sim/run_case.hpp"
 #include "sim/units.hpp"
@@ -34,7 +35,7 @@ void print_units(const cases::CaseSpec& spec, const sim::LatticeUnits& u) {
     // TRT: the odd moments' relaxation time too; far above 1 it lets interface and IB errors persist.
     const auto& col = spec.numerics.collision;
     const std::string tau_minus = col.op == cases::CollisionSpec::Operator::trt
-                                      ? fmt::format(" (tau- = {:.3g})", 0.5 + col.magic / (b.tau - 0.5))
+                                      ? fmt::format(" (tau- = {:.3g})", collision::Trt{b.tau, col.magic}.tau_minus())
                                       : std::string();
     fmt::print("  block {:8s} dx = {:.5g} L, dt = {:.5g} L/U, tau = {:.5f}{}, nu_lu = {:.5g}, nodes {}\n", b.name, b.dx,
                b.dt, b.tau, tau_minus, b.nu_lu, nodes);

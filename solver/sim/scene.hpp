@@ -758,7 +758,8 @@ class Scene {
               : fmt::format("with TRT the odd moments relax with tau- = 1/2 + magic / (tau - 1/2) = {:.3g}, slowly, "
                             "and the errors the refinement interface or the immersed boundary put there persist: "
                             "a smaller numerics.collision.magic ({:.3g} gives tau- = {:.3g})",
-                            0.5 + col.magic / (tau - 0.5), col.magic / 3, 0.5 + col.magic / 3 / (tau - 0.5));
+                            collision::Trt{tau, col.magic}.tau_minus(), col.magic / 3,
+                            collision::Trt{tau, col.magic / 3}.tau_minus());
       return fmt::format("tau = {:.4f} on this block is close to 1/2 for this Reynolds number and grid; {}, a finer "
                          "grid or a higher numerics.lattice_velocity (tau - 1/2 grows with it at a fixed Re, as far as "
                          "the Mach number allows)",
