@@ -64,8 +64,16 @@ def stable_time_step(re, a_lu, G, law, C=None, tau_f=3.5):
 def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, fine, fine_per_a, subdivisions,
          end_time, average_from, walls=False, C=None, refinement="two_level", tau_f=3.5,
          acceptance=(), quick_end=None, snapshots=(), quick_speedup=2, performance=None, quick_margin=0,
-         series=SERIES):
+         series=SERIES, magic=None, quick_at_standard=None, note="", oscillation_threshold=None):
+    """One case file. magic: the TRT magic parameter where the default 1/4 does not do (as a fraction string
+    "1/12"); quick_at_standard: why quick keeps the standard grid (then quick is the standard run); note: a last
+    sentence of the description (why magic or oscillation_threshold is set); oscillation_threshold: degrees,
+    outputs.oscillation_threshold where a smaller swing than the default's must count."""
     u = lattice_velocity(re, fine_per_a, tau_f)
+    magic_value = None
+    if magic:
+        num, den = magic.split("/")
+        magic_value = int(num) / int(den)
     membrane = {"law": law, "capillary": G, "subdivisions": subdivisions}
     if C is not None:
         membrane["area_dilation"] = C
@@ -77,15 +85,17 @@ def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, f
         "id": f"{chapter}/{cid}",
         "title": title,
         "description": description + (
-            f" Lattice: fine spacing a/{fine_per_a}, k a = {u:g} in lattice units (tau_f = {tau_f}, TRT), "
+            f" Lattice: fine spacing a/{fine_per_a}, k a = {u:g} in lattice units (tau_f = {tau_f}, TRT"
+            + (f" with magic {magic}" if magic else "") + "), "
             f"{4 ** subdivisions * 8} triangles, single-precision populations (measured on the NH sphere at G = 0.05: "
             "the same steady D as double precision to 1e-6, 13 % less run time at quick; level thesis: double). "
-            f"Quick: half the resolution (a/{fine_per_a // 2}, "
-            f"{4 ** (subdivisions - 1) * 8} triangles) and "
-            + ("twice the lattice velocity (same tau_f)." if quick_speedup == 2 else
-               "the same lattice velocity (the walls' Mach number stays below 0.25; tau_f closer to 1/2)."
-               if quick_speedup == 1 else
-               f"{quick_speedup:g} times the lattice velocity (the membrane's lattice modulus bounds the time step).")),
+            + (f"Quick: the standard resolution. {quick_at_standard}" if quick_at_standard else
+               f"Quick: half the resolution (a/{fine_per_a // 2}, {4 ** (subdivisions - 1) * 8} triangles) and "
+               + ("twice the lattice velocity (same tau_f)." if quick_speedup == 2 else
+                  "the same lattice velocity (the walls' Mach number stays below 0.25; tau_f closer to 1/2)."
+                  if quick_speedup == 1 else
+                  f"{quick_speedup:g} times the lattice velocity (the membrane's lattice modulus bounds the time step)."))
+            + (f" {note}" if note else "")),
         "physics": {
             "dimension": 3,
             "flow": {"type": "shear"},
@@ -98,7 +108,7 @@ def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, f
         },
         "numerics": {
             "grid": grid,
-            "collision": {"operator": "trt"},
+            "collision": {"operator": "trt", **({"magic": magic_value} if magic else {})},
             "precision": "single",
             "ib": {"kernel": "cosine4"},
             "lattice_velocity": u,
@@ -117,11 +127,15 @@ def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, f
             # t = 0: the rest mesh (XDMF, with the fluid's initial state).
             "snapshots": {"times": [0] + (list(snapshots) or [end_time]), "fields": ["velocity", "vorticity"]},
             "average_from": average_from,
+            **({"oscillation_threshold": oscillation_threshold} if oscillation_threshold else {}),
         },
         "acceptance": list(acceptance),
     }
     if performance:  # a wall-time budget per level: score.json's performance verdict
         doc["performance"] = performance
+    if quick_at_standard:
+        doc["fidelity"]["quick"] = {}
+        return doc
     if quick_end:
         doc["fidelity"]["quick"]["outputs.snapshots.times"] = [0, quick_end]
     # The fine block's faces lie on coarse nodes: at the quick level's coarser grid, widen the

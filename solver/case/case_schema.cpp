@@ -155,6 +155,7 @@ SchemaNode build_case_schema() {
           object({req("times", array_of(number(at_least(0)))),
                   req("fields", array_of(choice({"density", "velocity", "vorticity"})))})),  // sim/scene.hpp
       opt("average_from", number(at_least(0))),
+      opt("oscillation_threshold", number(Range{0, 45, true, false})),
       opt("checkpoint", object({opt("interval", number(at_least(0))), opt("wall_seconds", number(at_least(0)))})),
   });
   // Numeric comparisons need "reference_value" and "tolerance", "mode" needs "reference_mode"

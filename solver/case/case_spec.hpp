@@ -179,6 +179,9 @@ struct OutputSpec {
   SeriesSpec series;
   SnapshotSpec snapshots;
   double average_from = 0.0;  ///< start of the window for means, amplitudes and frequencies (L/U)
+  /// Smallest reversal of a capsule's inclination, in degrees, that counts as swinging: twice this,
+  /// peak to peak, in the window (diagnostics::classify_capsule_motion).
+  double oscillation_threshold_deg = 1.0;
   CheckpointSpec checkpoint;
 };
 

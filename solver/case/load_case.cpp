@@ -302,6 +302,7 @@ CaseSpec to_spec(const json& doc, const CaseDiagnostics& diag) {
     spec.outputs.snapshots.fields = o.at("snapshots").at("fields").get<std::vector<std::string>>();
   }
   spec.outputs.average_from = o.value("average_from", spec.outputs.average_from);
+  spec.outputs.oscillation_threshold_deg = o.value("oscillation_threshold", spec.outputs.oscillation_threshold_deg);
   const json checkpoint = o.value("checkpoint", json::object());
   spec.outputs.checkpoint.interval = checkpoint.value("interval", spec.outputs.checkpoint.interval);
   spec.outputs.checkpoint.wall_seconds = checkpoint.value("wall_seconds", spec.outputs.checkpoint.wall_seconds);
@@ -373,6 +374,7 @@ void complete(CaseSpec& spec, json& resolved) {
   resolved["outputs"]["snapshots"] = {{"times", spec.outputs.snapshots.times},
                                       {"fields", spec.outputs.snapshots.fields}};
   resolved["outputs"]["average_from"] = spec.outputs.average_from;
+  resolved["outputs"]["oscillation_threshold"] = spec.outputs.oscillation_threshold_deg;
   resolved["outputs"]["checkpoint"] = {{"interval", spec.outputs.checkpoint.interval},
                                        {"wall_seconds", spec.outputs.checkpoint.wall_seconds}};
   if (!resolved.contains("acceptance")) resolved["acceptance"] = json::array();

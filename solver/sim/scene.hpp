@@ -982,15 +982,16 @@ class Scene {
     }
     const auto* theta = column("inclination");
     if (!theta) return;
-    const auto motion = diagnostics::classify_capsule_motion(t, *theta, from);
+    const double threshold_deg = spec_.outputs.oscillation_threshold_deg;
+    const auto motion = diagnostics::classify_capsule_motion(t, *theta, from, threshold_deg * std::numbers::pi / 180);
     metrics[prefix + "mode"] = {
         {"value", motion.mode},
         {"unit", ""},
         {"definition", fmt::format("tumbling when the inclination turns through more than pi over the run (it "
                                    "turned {:.3f} rad); else oscillating_tank_treading when it reverses{} by more "
-                                   "than 2 degrees (it reversed {} times; (max - min)/2 = {:.4f} rad), else "
-                                   "steady_tank_treading",
-                                   motion.inclination_turn, window, motion.inclination_reversals,
+                                   "than {:g} degrees (outputs.oscillation_threshold, twice; it reversed {} times; "
+                                   "(max - min)/2 = {:.4f} rad), else steady_tank_treading",
+                                   motion.inclination_turn, window, 2 * threshold_deg, motion.inclination_reversals,
                                    motion.inclination_amplitude)}};
     if (motion.mode == "tumbling") {
       if (motion.tumbling_period)

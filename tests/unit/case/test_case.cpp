@@ -660,11 +660,21 @@ TEST(case_schema, DefaultsMatchTheSpecDefaults) {
   EXPECT_EQ(numerics["threads"]["default"], defaults.numerics.threads);
   EXPECT_EQ(schema["properties"]["outputs"]["properties"]["average_from"]["default"],
             defaults.outputs.average_from);
+  EXPECT_EQ(schema["properties"]["outputs"]["properties"]["oscillation_threshold"]["default"],
+            defaults.outputs.oscillation_threshold_deg);
 }
 
 // ---------------------------------------------------------------- capsules
 const fs::path capsule_file = source_dir / "catalogue/ch3/ellipse_initial_G0.04_Eb0.4.json";
 json capsule_json() { return read_case_json(capsule_file); }
+
+TEST(case_capsule, OscillationThresholdIsReadAndRecordedInTheResolvedCase) {
+  const CaseSpec spec = load_case(capsule_file, "standard", {"outputs.oscillation_threshold=0.25"});
+  EXPECT_DOUBLE_EQ(spec.outputs.oscillation_threshold_deg, 0.25);
+  EXPECT_EQ(spec.resolved["outputs"]["oscillation_threshold"], 0.25);
+  EXPECT_DOUBLE_EQ(load_case(capsule_file, "standard").outputs.oscillation_threshold_deg, 1.0);
+  expect_set_rejected({"outputs.oscillation_threshold=0"}, "/outputs/oscillation_threshold", {"(0, 45]"});
+}
 
 TEST(case_capsule, LoadsTheMembraneAndShapeWithDefaultsWritten) {
   const CaseSpec spec = load_case(capsule_file, "standard");
