@@ -57,11 +57,22 @@ def mach(u, domain=16):
     return domain / 2 * u * 3 ** 0.5
 
 
-def setup(re, fine_spacing=0.05):
+#: The fine block's half width (in a) around the capsule: [5a, 11a]^2 in the thesis's 16a domain.
+FINE_HALF_WIDTH = 3
+
+
+def fine_region(domain):
+    """The fine block, centred on the capsule at the domain's centre: [5, 5]-[11, 11] for 16a (thesis 3.1.2)."""
+    c = domain // 2
+    return {"min": [c - FINE_HALF_WIDTH] * 2, "max": [c + FINE_HALF_WIDTH] * 2}
+
+
+def setup(re, fine_spacing=0.05, domain=16):
     """The description's opening for the low-Reynolds capsules (thesis 2.2.4 and chapter 3), with the case's
-    own grid and relaxation times; the sentence on the quick level follows it (QUICK_HALF unless a case says
-    otherwise)."""
+    own grid, domain and relaxation times; the sentence on the quick level follows it (QUICK_HALF unless a case
+    says otherwise)."""
     h = fine_spacing
+    lo, hi = fine_region(domain)["min"][0], fine_region(domain)["max"][0]
 
     def taus(u):
         return f"tau_c = {tau(re, u, 2 * h):.3g}, tau_f = {tau(re, u, h):.3g}"
@@ -69,13 +80,16 @@ def setup(re, fine_spacing=0.05):
     magic = thesis_magic(re, h)
     return ("Liquid-filled 2D capsule with a Hookean membrane (thesis eq. 3.6) and bending moment m = E_B (kappa - "
             "kappa_0) (eq. 3.8) in unbounded simple shear u = (k y, 0) imposed on all four faces (non-equilibrium "
-            f"extrapolation), domain 16a x 16a, capsule at the centre, fine block [5a, 11a]^2 with spacing {h:.3g}a, "
-            f"coarse {2 * h:.3g}a (thesis 3.1.2{'' if h == 0.05 else ': 0.05a and 0.1a'}). Units: a = equivalent "
+            f"extrapolation), domain {domain}a x {domain}a, capsule at the centre, fine block [{lo}a, {hi}a]^2 with "
+            f"spacing {h:.3g}a, "
+            f"coarse {2 * h:.3g}a (thesis 3.1.2{'' if h == 0.05 else ': 0.05a and 0.1a'}"
+            f"{'' if domain == 16 else ', in a domain of 16a'}). Units: a = equivalent "
             "radius (area/pi)^0.5, velocity k a, time 1/k; Re = rho (2ka)(2a)/mu, G = mu k a / E (eq. 3.9), "
             "E_b = E_B/(a^2 E) (eq. 3.10). "
             f"Lattice velocity: the thesis uses 2ka = 1e-4 (k a = 5e-5, BGK; {taus(THESIS_U)} at this Re = {re:g} "
             f"and grid), kept by level thesis; standard uses k a = 2e-4 with TRT ({taus(STANDARD_U)}: four times "
-            f"fewer steps; the Mach number at the domain edge (8 k a) is {mach(STANDARD_U):.2g}) and the magic "
+            f"fewer steps; the Mach number at the domain edge ({domain // 2} k a) is {mach(STANDARD_U, domain):.2g}) and "
+            "the magic "
             f"parameter of the thesis's BGK on the fine block, (tau_f - 1/2)^2 = {magic:g} (TRT's steady solutions "
             "depend on it alone at a fixed grid; with 1/4 the immersed boundary's area leak was 1.6 times the "
             "thesis level's, references/capsule2d/provenance.json), ")
@@ -110,14 +124,16 @@ def area_change(quick="quick runs at half the resolution, where the IB leaks mor
 AREA_CHANGE = area_change()
 
 
-def budget(end_time, resolution):
-    """The wall-time budget of a thesis-resolution case: 5 minutes per 10 shear times at standard."""
-    seconds = 300.0 * end_time / 10
-    return {"wall_time_budget_s": {"standard": seconds},
+def budget(end_time, resolution, larger=None):
+    """The wall-time budget of a thesis-resolution case: 5 minutes per 10 shear times at standard. larger =
+    (factor, why): a case with `factor` times the node updates of its thesis-sized original gets that much more."""
+    factor, why = larger or (1, "")
+    seconds = round(300.0 * end_time / 10 * factor)
+    return {"wall_time_budget_s": {"standard": float(seconds)},
             "justification": "The cost target of the issue that added the 2D capsules: a thesis-resolution case "
                              f"({resolution}) runs 10 shear times in at most 5 minutes at standard fidelity on the "
-                             f"2-core development machine; this run is k t = {end_time} long, hence "
-                             f"{seconds:g} s."}
+                             f"2-core development machine; this run is k t = {end_time} long"
+                             + (f", {why}, hence {seconds:g} s." if larger else f", hence {seconds:g} s.")}
 
 
 def shorter_run(end_time, average_from):
@@ -137,7 +153,7 @@ def case(cid, title, description, *, shape, G, re, end_time, average_from, Eb=0.
     snapshots = list(snapshots) if snapshots else [end_time]
     grid = {"refinement": refinement, "fine_spacing": fine_spacing}
     if refinement == "two_level":
-        grid["fine_region"] = {"min": [5, 5], "max": [11, 11]}
+        grid["fine_region"] = fine_region(domain)
     if quick is None:
         quick = {"numerics.grid.fine_spacing": 2 * fine_spacing, "numerics.lattice_velocity": quick_speedup * u}
         if not quick_keeps_nodes:

@@ -328,12 +328,15 @@ def _run_labels(runs: list[Run]) -> dict[int, str]:
                if len({p.get(k) for p in params}) > 1] or ["capillary", "bending_ratio"]
     several_fidelities = len({r.fidelity for r in runs}) > 1
     several_grids = len({r.fine_spacing for r in runs}) > 1
+    several_domains = len({_domain(r) for r in runs}) > 1
     labels = {}
     for run, p in zip(runs, params):
         text = ", ".join(f"{PARAMETER_SYMBOLS[k]} = {p[k]:g}" for k in varying if finite(p.get(k)))
         extra = [run.fidelity] if several_fidelities else []
         if several_grids and run.fine_spacing:
             extra.append(f"Δx_f = {run.fine_spacing:g}")
+        if several_domains and _domain(run):
+            extra.append("domain " + _domain_text(run))
         labels[id(run)] = text + (f" ({', '.join(extra)})" if extra else "")
     return labels
 
@@ -450,6 +453,10 @@ def _domain(run: Run) -> tuple:
     return tuple(size) if isinstance(size, list) else ()
 
 
+def _domain_text(run: Run) -> str:
+    return " × ".join(f"{x:g}" for x in _domain(run))
+
+
 def _nodes(run: Run) -> int | None:
     n = ((capsule_body(run) or {}).get("membrane") or {}).get("nodes")
     return int(n) if finite(n) else None
@@ -521,7 +528,7 @@ def series_groups(runs: list[Run], cache: dict) -> list[Series]:
                 th = _rms_to_reference(run, ref, "inclination", cache)
                 errors.append((run.fine_spacing, d[0] if d else None))
                 group.rows.append({"run": run.case_id, "fidelity": run.fidelity, "anchor": run.anchor,
-                                   "spacing": f"{run.fine_spacing:g}", "domain": " × ".join(f"{x:g}" for x in _domain(run)),
+                                   "spacing": f"{run.fine_spacing:g}", "domain": _domain_text(run),
                                    "nodes": _nodes(run) or "–",
                                    "d_rms": f"{d[0]:.3g}" if d else "–", "d_max": f"{d[1]:.3g}" if d else "–",
                                    "theta_rms": f"{th[0]:.3g}" if th else "–", "order": ""})
@@ -543,7 +550,7 @@ def _series_figure(group: Series, cache: dict) -> str | None:
         last = i == len(group.runs) - 1
         tag = (f"Δx_f = {run.fine_spacing:g}, {_nodes(run)} nodes" if group.what == "grid"
                else f"{_nodes(run)} nodes" if group.what == "nodes"
-               else "domain " + " × ".join(f"{x:g}" for x in _domain(run)))
+               else "domain " + _domain_text(run))
         tag += " (self-reference)" if last else ""
         for ax, name, scale in ((axes[0], "taylor_deformation", 1.0), (axes[1], "inclination", math.pi)):
             if name in data:

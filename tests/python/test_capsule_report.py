@@ -57,6 +57,9 @@ def capsule_runs():
            reference_mode="tumbling"), "tumbling"),
         (C("ch3/ellipse_G0.04_Eb0.4", bending_ratio=0.4, claim="ch3.ellipse.G0.04.Eb0.4",
            reference_mode="tumbling"), "tumbling"),
+        # its twin in a larger domain (Jeffery's orbit is scored there): same parameters, told apart by the domain
+        (C("ch3/ellipse_G0.04_Eb0.4_domain32", bending_ratio=0.4, domain=32.0, claim="ch3.ellipse.G0.04.Eb0.4",
+           reference_mode="tumbling"), "tumbling"),
         (C("ch3/biconcave_G0.025_Eb0.02", shape="biconcave", capillary=0.025, bending_ratio=0.02, reynolds=0.027,
            claim="ch3.biconcave.G0.025.Eb0.02", reference_mode="tumbling"), "tumbling"),
     ]
@@ -122,14 +125,18 @@ def test_families_overlay_runs_with_jeffery(built):
     page = built["text"][3]
     assert "elliptical (r = 2) capsules, minimum bending-energy shape: the initial shape" in page
     assert "biconcave (α = 1.39) capsules" in page
-    # per family D_xy, inclination and contours; one time-history figure per run with a series
-    assert len(parse(built["out"] / "chapter3" / "index.html").imgs) == 2 * 3 + 6
+    # per family D_xy, inclination and contours; one time-history figure per run with a series; the
+    # domain study of the E_b = 0.4 pair
+    assert len(parse(built["out"] / "chapter3" / "index.html").imgs) == 2 * 3 + 7 + 1
     assert "Jeffery's orbit of a rigid ellipse with r = 2 from the initial angle(s) 0 rad" in page
     assert "verification, analytic" in page
     # the Jeffery verification table, labelled
     html = built["html"][3]
     section = text(html[html.index('id="capsule-verification"'):html.index('id="cases"')], " ")
     assert "π(1 + r²)/r = 7.8540" in section and "E_b = 0.4" in section
+    # runs that differ only in the domain are labelled with it, in the table and the legends
+    assert "E_b = 0.4 (domain 16 × 16)" in section and "E_b = 0.4 (domain 32 × 32)" in section
+    assert "Domain size" in section
 
 
 def test_scorecard_mode_rows_are_strings(built):
