@@ -552,6 +552,19 @@ class Scene {
                        h.min_ratio, h.max_ratio, h.folded >= 0 ? ", folded" : "");
   }
 
+  /// The likely cause of a capsule that reached the fine block's edge with no element over the
+  /// blow-up limits. Those limits miss a thin spike of nodes each stretched less than 3 times, so
+  /// the message gives the element state and where to look rather than calling the membrane healthy.
+  static std::string reached_block_edge(const Capsule<D>& c) {
+    const auto h = c.membrane().health(c.positions());
+    return fmt::format("the capsule reached the fine block's edge with its elements at {:.3g} to {:.3g} times their "
+                       "rest size and none folded: if it moved or deformed that far (the last rows of "
+                       "series.h5.partial show a smooth deformation), enlarge the fine region "
+                       "(numerics.grid.fine_region) or move the capsule away from its edge; if its deformation jumps "
+                       "in those rows, the membrane diverged locally (a smaller numerics.lattice_velocity)",
+                       h.min_ratio, h.max_ratio);
+  }
+
   /// Runs f() for capsule `c`; a core::Error from the IB stage (a stencil off the block, a
   /// non-finite position) becomes a NumericalError naming the capsule, the step and, from the
   /// state of its membrane, which of the two usual causes it is.
@@ -563,9 +576,7 @@ class Scene {
       throw;
     } catch (const core::Error& e) {
       throw core::NumericalError(step_, fmt::format("immersed boundary of capsule '{}'", c.name()), e.what(),
-                                 blown_up(c) ? diverged_membrane(c)
-                                          : "the capsule left the fine block with a healthy membrane: enlarge the fine "
-                                            "region (numerics.grid.fine_region) or move the capsule away from its edge");
+                                 blown_up(c) ? diverged_membrane(c) : reached_block_edge(c));
     }
   }
 
