@@ -72,7 +72,8 @@ def setup(re, fine_spacing=0.05, domain=16):
     own grid, domain and relaxation times; the sentence on the quick level follows it (QUICK_HALF unless a case
     says otherwise)."""
     h = fine_spacing
-    lo, hi = fine_region(domain)["min"][0], fine_region(domain)["max"][0]
+    region = fine_region(domain)
+    lo, hi = region["min"][0], region["max"][0]
 
     def taus(u):
         return f"tau_c = {tau(re, u, 2 * h):.3g}, tau_f = {tau(re, u, h):.3g}"

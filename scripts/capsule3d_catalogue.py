@@ -7,6 +7,7 @@ time 1/k, Re = rho k a^2 / mu (thesis section 5.3), G = mu k a / E with the E of
 shear u = (k z, 0, 0): x-z is the shear plane.
 """
 import math
+from fractions import Fraction
 
 SERIES = ["taylor_deformation", "inclination", "length", "width", "thickness", "volume_change",
           "surface_area_change", "max_area_change", "tank_treading_phase"]
@@ -70,10 +71,6 @@ def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, f
     sentence of the description (why magic or oscillation_threshold is set); oscillation_threshold: degrees,
     outputs.oscillation_threshold where a smaller swing than the default's must count."""
     u = lattice_velocity(re, fine_per_a, tau_f)
-    magic_value = None
-    if magic:
-        num, den = magic.split("/")
-        magic_value = int(num) / int(den)
     membrane = {"law": law, "capillary": G, "subdivisions": subdivisions}
     if C is not None:
         membrane["area_dilation"] = C
@@ -108,7 +105,7 @@ def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, f
         },
         "numerics": {
             "grid": grid,
-            "collision": {"operator": "trt", **({"magic": magic_value} if magic else {})},
+            "collision": {"operator": "trt", **({"magic": float(Fraction(magic))} if magic else {})},
             "precision": "single",
             "ib": {"kernel": "cosine4"},
             "lattice_velocity": u,

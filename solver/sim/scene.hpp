@@ -542,27 +542,31 @@ class Scene {
     return !(h.max_ratio < 3.0) || !(h.min_ratio > spec_.numerics.guards.min_area_ratio) || h.folded >= 0;
   }
 
+  /// The state of the elements of `c`'s membrane, for the failure messages.
+  static std::string element_state(const Capsule<D>& c) {
+    const auto h = c.membrane().health(c.positions());
+    return fmt::format("elements at {:.3g} to {:.3g} times their rest size, {}", h.min_ratio, h.max_ratio,
+                       h.folded >= 0 ? "folded" : "none folded");
+  }
+
   /// The likely cause of a membrane that has blown up, with the state of its elements.
   static std::string diverged_membrane(const Capsule<D>& c) {
-    const auto h = c.membrane().health(c.positions());
-    return fmt::format("the membrane nodes diverged (elements at {:.3g} to {:.3g} times their rest size{}): the "
-                       "explicit membrane-fluid coupling is too stiff for the time step, which happens at small "
-                       "capillary numbers G; lower numerics.lattice_velocity (a smaller time step; at a fixed Reynolds "
-                       "number the membrane's lattice modulus falls as its square)",
-                       h.min_ratio, h.max_ratio, h.folded >= 0 ? ", folded" : "");
+    return fmt::format("the membrane nodes diverged ({}): the explicit membrane-fluid coupling is too stiff for the "
+                       "time step, which happens at small capillary numbers G; lower numerics.lattice_velocity (a "
+                       "smaller time step; at a fixed Reynolds number the membrane's lattice modulus falls as its "
+                       "square)",
+                       element_state(c));
   }
 
   /// The likely cause of a capsule that reached the fine block's edge with no element over the
   /// blow-up limits. Those limits miss a thin spike of nodes each stretched less than 3 times, so
   /// the message gives the element state and where to look rather than calling the membrane healthy.
   static std::string reached_block_edge(const Capsule<D>& c) {
-    const auto h = c.membrane().health(c.positions());
-    return fmt::format("the capsule reached the fine block's edge with its elements at {:.3g} to {:.3g} times their "
-                       "rest size and none folded: if it moved or deformed that far (the last rows of "
-                       "series.h5.partial show a smooth deformation), enlarge the fine region "
+    return fmt::format("the capsule reached the fine block's edge with its {}: if it moved or deformed that far (the "
+                       "last rows of series.h5.partial show a smooth deformation), enlarge the fine region "
                        "(numerics.grid.fine_region) or move the capsule away from its edge; if its deformation jumps "
                        "in those rows, the membrane diverged locally (a smaller numerics.lattice_velocity)",
-                       h.min_ratio, h.max_ratio);
+                       element_state(c));
   }
 
   /// Runs f() for capsule `c`; a core::Error from the IB stage (a stencil off the block, a

@@ -77,6 +77,9 @@ TEST(CapsuleMotion, OscillatingTankTreading) {
   // The same signal with a 0.5 degree wobble is steady.
   const auto small = sample(20, 0.01, [&](double t) { return 0.3 + amp / 6 * std::sin(2 * t); });
   EXPECT_EQ(classify_capsule_motion(small.t, small.theta, 5).mode, "steady_tank_treading");
+  // ... and swinging once the threshold (a case's outputs.oscillation_threshold) is 0.25 degree,
+  // i.e. a 0.5 degree reversal counts.
+  EXPECT_EQ(classify_capsule_motion(small.t, small.theta, 5, 0.25 * pi / 180).mode, "oscillating_tank_treading");
 }
 
 TEST(CapsuleMotion, JefferyOrbitTumblesWithItsPeriod) {
