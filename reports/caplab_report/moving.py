@@ -516,9 +516,11 @@ def describe(claim: dict, t_from: float = 0.0) -> str:
             return (f"RMS of the difference from the uniform-grid twin after t = {t_from:g}, over the twin's peak, "
                     f"for {', '.join(symbol(c) for c in spec.get('columns', []))}: at most {pct(claim.get('upper'))}")
         if kind == "refinement":
-            return (f"RMS of the difference from the same case on the finest two-block grid run, "
-                    f"after t = {t_from:g}, over its peak, "
-                    f"for {', '.join(symbol(c) for c in spec.get('columns', []))}: at most {pct(claim.get('upper'))}")
+            about = spec.get("fine_spacing")
+            return (f"RMS of the difference from the finest two-block grid of the study ({', '.join(claim.get('cases', []))}) "
+                    f"at the same fidelity, after t = {t_from:g}, over its peak, "
+                    f"for {', '.join(symbol(c) for c in spec.get('columns', []))}: at most {pct(claim.get('upper'))}"
+                    + (f"; runs coarser than the statement's Δx_f = {about:g} are not judged" if about else ""))
         if kind == "fine_fraction":
             return (f"fine-block area over domain area within {100 * spec['tolerance']:g} % of {100 * claim['value']:g} %; "
                     f"node updates of the uniform twin above those of the two-block run; the saving below that of "

@@ -695,38 +695,56 @@ void Check::twin(const std::vector<ClaimRun*>& about) {
 void Check::refinement(const std::vector<ClaimRun*>& about) {
   const std::vector<std::string> cols = columns();
   const double tolerance = number(claim_, "upper", "");
-  std::vector<std::pair<std::string, std::vector<ClaimRun*>>> by_case;  // in the order of `about`
+  const json& statement = member(spec_, "fine_spacing");
+  if (!statement.is_null() && !(finite(statement) && statement.get<double>() > 0))
+    throw Malformed("check.fine_spacing must be a positive number (the fine spacing the statement is about)");
+  const double about_spacing = statement.is_null() ? 0.0 : statement.get<double>();  // 0: any grid
+  const std::string about_note =
+      about_spacing > 0 ? fmt::format("; the statement is about Δx_f = {:g}", about_spacing) : std::string();
+  const auto coarser = [](double h, double than) { return h > than * (1 + 1e-9); };
+  // One grid study per fidelity: the claim's cases differ only in the grid, and a level's
+  // numerics are the same for all of them, so runs of one level differ in the grid alone.
+  std::vector<std::pair<std::string, std::vector<ClaimRun*>>> by_level;  // in the order of `about`
   for (ClaimRun* run : about) {
     if (run->status != "ok") {
       unjudged(*run, run_status_note(*run));
       continue;
     }
     if (grid_refinement(*run) != "two_level" || !fine_spacing(*run)) continue;
-    auto it =
-        std::find_if(by_case.begin(), by_case.end(), [&](const auto& c) { return c.first == run->case_id; });
-    if (it == by_case.end()) it = by_case.insert(by_case.end(), {run->case_id, {}});
+    auto it = std::find_if(by_level.begin(), by_level.end(),
+                           [&](const auto& c) { return c.first == run->fidelity; });
+    if (it == by_level.end()) it = by_level.insert(by_level.end(), {run->fidelity, {}});
     it->second.push_back(run);
   }
-  for (auto& [case_id, members] : by_case) {
+  for (auto& [level, members] : by_level) {
     std::stable_sort(members.begin(), members.end(), [](const ClaimRun* a, const ClaimRun* b) {
       return *fine_spacing(*a) > *fine_spacing(*b);
     });
     ClaimRun& finest = *members.back();
     const double h = *fine_spacing(finest);
-    std::vector<ClaimRun*> coarser;
-    for (ClaimRun* m : members)
-      if (*fine_spacing(*m) > h * (1 + 1e-9)) coarser.push_back(m);
-    if (coarser.empty()) {
-      std::vector<std::string> grids;
-      for (const ClaimRun* m : members)
-        grids.push_back(fmt::format("Δx_f = {:g} ({})", *fine_spacing(*m), m->fidelity));
-      unjudged(finest, "one grid only (" + join(grids, ", ") + "): nothing to refine against", "", true);
-      continue;
+    bool compared = false;
+    for (ClaimRun* run : members) {
+      const double hr = *fine_spacing(*run);
+      if (!coarser(hr, h)) continue;
+      if (about_spacing > 0 && coarser(hr, about_spacing)) {
+        unjudged(*run, fmt::format("not judged: Δx_f = {:g} is coarser than the grid the statement is about "
+                                   "(Δx_f = {:g})",
+                                   hr, about_spacing));
+        continue;
+      }
+      difference(*run, finest, cols, tolerance, "grids",
+                 fmt::format("Δx_f = {:g} against the finer Δx_f = {:g} at fidelity {} (self-reference)", hr, h,
+                             level));
+      compared = true;
     }
-    for (ClaimRun* run : coarser)
-      difference(
-          *run, finest, cols, tolerance, "grids",
-          fmt::format("Δx_f = {:g} against the finer Δx_f = {:g} (self-reference)", *fine_spacing(*run), h));
+    if (!compared) {
+      std::vector<std::string> grids;
+      for (const ClaimRun* m : members) grids.push_back(fmt::format("Δx_f = {:g} ({})", *fine_spacing(*m), m->case_id));
+      unjudged(finest,
+               fmt::format("no finer grid at fidelity {} to refine against ({}){}", level, join(grids, ", "),
+                           about_note),
+               "", true);
+    }
   }
 }
 

@@ -30,9 +30,13 @@
 //                    numerics.grid.refinement "two_level": another run with refinement "uniform",
 //                    the same fidelity, equal "physics" and fine spacing (rel 1e-9); finished runs
 //                    first, then the one named "<case id>_uniform", then by case id.
-//   refinement       per case: each two-level run whose fine spacing is coarser (by more than
-//                    rel 1e-9) than the finest finished two-level run of the same case, against
-//                    that finest run (the self-reference), as for twin.
+//   refinement       per fidelity: the claim's "cases" are one grid study (a case and its
+//                    members on finer grids, equal apart from numerics.grid), and a level's runs
+//                    differ in the grid alone. Each two-level run whose fine spacing is coarser (by
+//                    more than rel 1e-9) than the finest finished two-level run at its fidelity is
+//                    compared with that run (the self-reference), as for twin. "check.fine_spacing"
+//                    (optional): the grid the statement is about ("further refinement of this grid
+//                    gives nearly the same results"); runs coarser than it are listed, not judged.
 //   fine_fraction    per run, up to three rows ("part"): "fine fraction" = area of
 //                    numerics.grid.fine_region over that of physics.domain.size, within
 //                    check.tolerance of the claim's "value" ("as built", the fine block's node
@@ -57,7 +61,7 @@
 //   "against"  (twin, refinement) "<case id> (<fidelity>)" of the reference run.
 // Verdict: "inconsistent" when a row fails; "consistent" when one passes (the message names the
 // rows not judged); else "no run" when no run of "cases" finished "ok", "not enough runs" when a
-// row waits for a partner run (no twin, one grid only, no compare_with pair), "not checked"
+// row waits for a partner run (no twin, no finer grid, no compare_with pair), "not checked"
 // otherwise (columns missing, no encounter, a malformed check or an unknown type).
 #pragma once
 

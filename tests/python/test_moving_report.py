@@ -137,7 +137,7 @@ def test_method_statements_on_the_quick_runs(built):
     assert "node updates twin/two-block 2.75 (saving 63.60 %)" in fraction and "not judged: noisy" in fraction
     assert "no finished pair ch2/cylinder_re100 + uniform twin at fidelity quick" in fraction
     refinement = claim_row(html, "ch2.hovering_wing.refinement")
-    assert "NOT ENOUGH RUNS" in refinement and "one grid only" in refinement
+    assert "NOT ENOUGH RUNS" in refinement and "no finer grid at fidelity quick" in refinement
 
 
 def test_verification_tables_on_the_quick_runs(built):
@@ -199,10 +199,10 @@ def fixture_case(case_id: str) -> dict:
 
 
 def write_run(path: Path, case: dict, columns: dict[str, np.ndarray], node_updates: float = 1e9,
-              wall: float = 100.0, status: str = "ok") -> Run:
+              wall: float = 100.0, status: str = "ok", fidelity: str = "quick") -> Run:
     path.mkdir(parents=True, exist_ok=True)
     (path / "case.json").write_text(json.dumps(case), encoding="utf-8")
-    manifest = {"status": status, "case_id": case["id"], "fidelity": "quick", "wall_time_s": wall, "mlups": 10.0,
+    manifest = {"status": status, "case_id": case["id"], "fidelity": fidelity, "wall_time_s": wall, "mlups": 10.0,
                 "threads": 2, "lattice": {"node_updates": node_updates}}
     (path / "manifest.json").write_text(json.dumps(manifest), encoding="utf-8")
     (path / "score.json").write_text(json.dumps({"verdict": "pass", "sanity": {"verdict": "pass"},
@@ -210,7 +210,7 @@ def write_run(path: Path, case: dict, columns: dict[str, np.ndarray], node_updat
     with h5py.File(path / "series.h5", "w") as h5:
         for name, values in columns.items():
             h5.create_dataset(name, data=np.asarray(values, dtype=float))
-    return load_run(path, case["id"], "quick")
+    return load_run(path, case["id"], fidelity)
 
 
 def cylinders(t: np.ndarray, drag: np.ndarray, lift_offset: float = 0.0) -> dict[str, np.ndarray]:
@@ -350,19 +350,29 @@ def test_fine_fraction_and_cost_checks(tmp_path):
 
 
 def test_refinement_check(tmp_path):
+    """The thesis's grid (1/64) against the finer member of the study at the same fidelity."""
     claim = claims()["ch2.hovering_wing.refinement"]
-    case = fixture_case("ch2/hovering_wing_re157")
+    quick = fixture_case("ch2/hovering_wing_re157")  # 1/32
+    case = copy.deepcopy(quick)
+    case["numerics"]["grid"]["fine_spacing"] = 1 / 64
+    finer = copy.deepcopy(case)
+    finer["id"] = "ch2/hovering_wing_re157_grid128"
+    finer["numerics"]["grid"]["fine_spacing"] = 1 / 128
     t = np.arange(0.02, 31.42, 0.02)
     base = {"t": t, "drag_coefficient": np.cos(0.8 * t), "lift_coefficient": 1 + np.sin(0.8 * t)}
-    finer = copy.deepcopy(case)
-    finer["numerics"]["grid"]["fine_spacing"] = case["numerics"]["grid"]["fine_spacing"] / 2
-    a = write_run(tmp_path / "a", case, base)
-    b = load_run(write_run(tmp_path / "b", finer, base).directory, case["id"], "standard")
+
+    def standard(name, doc, cols):
+        return write_run(tmp_path / name, doc, cols, fidelity="standard")
+
+    a = standard("a", case, base)
     assert judge(claim, [a]).verdict == "not enough runs"
-    assert judge(claim, [a, b]).verdict == "consistent"
-    c = load_run(write_run(tmp_path / "c", finer, dict(base, drag_coefficient=1.2 * np.cos(0.8 * t))).directory,
-                 case["id"], "standard")
+    assert judge(claim, [a, standard("b", finer, base)]).verdict == "consistent"
+    c = standard("c", finer, dict(base, drag_coefficient=1.2 * np.cos(0.8 * t)))
     assert judge(claim, [a, c]).verdict == "inconsistent"
+    # another fidelity is not a partner; a grid coarser than the statement's is not judged
+    assert judge(claim, [a, write_run(tmp_path / "d", finer, base)]).verdict == "not enough runs"
+    coarse = judge(claim, [write_run(tmp_path / "e", quick, base), write_run(tmp_path / "f", case, base)])
+    assert coarse.verdict == "not enough runs"
 
 
 def test_periodicity_and_period_means():

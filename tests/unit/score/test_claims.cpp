@@ -606,11 +606,14 @@ TEST_F(MotionClaims, TwinDifferenceAgainstTheUniformGrid) {
   EXPECT_EQ(differs["runs"][0]["details"][1], "the runs also differ in numerics.lattice_velocity");
 }
 
-TEST_F(MotionClaims, RefinementAgainstTheFinestGridOfTheCase) {
+TEST_F(MotionClaims, RefinementOfTheStatementsGridAtOneFidelity) {
   const std::string id = "ch2.hovering_wing.refinement";
-  const json wing = fixture_case("ch2__hovering_wing_re157");
-  json finer = wing;
-  finer["numerics"]["grid"]["fine_spacing"] = wing["numerics"]["grid"]["fine_spacing"].get<double>() / 2;
+  json thesis_grid = fixture_case("ch2__hovering_wing_re157");  // the quick run: 1/32
+  thesis_grid["numerics"]["grid"]["fine_spacing"] = 1.0 / 64;    // the grid of the statement
+  json finer = thesis_grid, quick = thesis_grid;
+  finer["id"] = "ch2/hovering_wing_re157_grid128";
+  finer["numerics"]["grid"]["fine_spacing"] = 1.0 / 128;
+  quick["numerics"]["grid"]["fine_spacing"] = 1.0 / 32;
   auto series = [](double drag_scale) {
     Columns c{{"t", {}}, {"drag_coefficient", {}}, {"lift_coefficient", {}}};
     for (double t = 0.02; t < 31.42; t += 0.02) {
@@ -620,18 +623,39 @@ TEST_F(MotionClaims, RefinementAgainstTheFinestGridOfTheCase) {
     }
     return c;
   };
-  const fs::path a = moving_run("a", wing, series(1.0));
+  const fs::path a = moving_run("a", thesis_grid, series(1.0), 1e9, "standard");
   const json one = moving(id, {a});
   EXPECT_EQ(one["verdict"], "not enough runs");
-  EXPECT_TRUE(contains(one["runs"][0]["note"], "one grid only (Δx_f = 0.03125 (quick))")) << one["runs"][0];
-  const json same = moving(id, {a, moving_run("b", finer, series(1.0), 1e9, "standard")});
+  EXPECT_TRUE(contains(one["runs"][0]["note"],
+                       "no finer grid at fidelity standard to refine against (Δx_f = 0.015625 "
+                       "(ch2/hovering_wing_re157)); the statement is about Δx_f = 0.015625"))
+      << one["runs"][0];
+
+  // The finer member of the study at the same fidelity is the self-reference.
+  const json same = moving(id, {a, moving_run("b", finer, series(1.0), 8e9, "standard")});
   EXPECT_EQ(same["verdict"], "consistent") << same.dump(2);
   EXPECT_EQ(same["runs"][0]["details"][0],
-            "Δx_f = 0.03125 against the finer Δx_f = 0.015625 (self-reference)");
-  EXPECT_EQ(same["runs"][0]["against"], "ch2/hovering_wing_re157 (standard)");
-  const json off = moving(id, {a, moving_run("c", finer, series(1.2), 1e9, "standard")});
+            "Δx_f = 0.015625 against the finer Δx_f = 0.0078125 at fidelity standard (self-reference)");
+  EXPECT_EQ(same["runs"][0]["against"], "ch2/hovering_wing_re157_grid128 (standard)");
+  const json off = moving(id, {a, moving_run("c", finer, series(1.2), 8e9, "standard")});
   EXPECT_EQ(off["verdict"], "inconsistent");
   EXPECT_TRUE(contains(off["runs"][0]["value"], "; C_l 0.00 % (at most 2.00 %)")) << off["runs"][0]["value"];
+
+  // Levels are not mixed: a finer run at another fidelity has other numerics.
+  EXPECT_EQ(moving(id, {a, moving_run("d", finer, series(1.0), 8e9, "quick")})["verdict"], "not enough runs");
+
+  // A grid coarser than the statement's is listed, not judged, even with a finer run beside it.
+  const json coarse = moving(id, {moving_run("e", quick, series(1.2), 1e8, "quick"),
+                                  moving_run("f", thesis_grid, series(1.0), 1e9, "quick")});
+  EXPECT_EQ(coarse["verdict"], "not enough runs") << coarse.dump(2);
+  EXPECT_TRUE(contains(coarse["runs"][0]["note"], "Δx_f = 0.03125 is coarser than the grid the statement is about"))
+      << coarse["runs"][0];
+  EXPECT_TRUE(coarse["runs"][0]["verdict"].is_null());
+
+  // The statement's grid must be a positive number.
+  json bad = moving_claim(id);
+  bad["check"]["fine_spacing"] = "1/64";
+  EXPECT_EQ(check(bad, {a})["verdict"], "not checked");
 }
 
 TEST_F(MotionClaims, FineFractionAndTheSavingOfTheTwoBlockGrid) {
