@@ -516,8 +516,8 @@ def describe(claim: dict, t_from: float = 0.0) -> str:
             return (f"RMS of the difference from the uniform-grid twin after t = {t_from:g}, over the twin's peak, "
                     f"for {', '.join(symbol(c) for c in spec.get('columns', []))}: at most {pct(claim.get('upper'))}")
         if kind == "refinement":
-            about = spec.get("fine_spacing")
-            return (f"RMS of the difference from the finest two-block grid of the study ({', '.join(claim.get('cases', []))}) "
+            about, study = spec.get("fine_spacing"), ", ".join(claim.get("cases", []))
+            return (f"RMS of the difference from the finest two-block grid of the study ({study}) "
                     f"at the same fidelity, after t = {t_from:g}, over its peak, "
                     f"for {', '.join(symbol(c) for c in spec.get('columns', []))}: at most {pct(claim.get('upper'))}"
                     + (f"; runs coarser than the statement's Δx_f = {about:g} are not judged" if about else ""))

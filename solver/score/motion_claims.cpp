@@ -727,19 +727,20 @@ void Check::refinement(const std::vector<ClaimRun*>& about) {
       const double hr = *fine_spacing(*run);
       if (!coarser(hr, h)) continue;
       if (about_spacing > 0 && coarser(hr, about_spacing)) {
-        unjudged(*run, fmt::format("not judged: Δx_f = {:g} is coarser than the grid the statement is about "
+        unjudged(*run, fmt::format("Δx_f = {:g} is coarser than the grid the statement is about "
                                    "(Δx_f = {:g})",
                                    hr, about_spacing));
         continue;
       }
       difference(*run, finest, cols, tolerance, "grids",
-                 fmt::format("Δx_f = {:g} against the finer Δx_f = {:g} at fidelity {} (self-reference)", hr, h,
-                             level));
+                 fmt::format("Δx_f = {:g} against the finer Δx_f = {:g} at fidelity {} (self-reference)", hr,
+                             h, level));
       compared = true;
     }
     if (!compared) {
       std::vector<std::string> grids;
-      for (const ClaimRun* m : members) grids.push_back(fmt::format("Δx_f = {:g} ({})", *fine_spacing(*m), m->case_id));
+      for (const ClaimRun* m : members)
+        grids.push_back(fmt::format("Δx_f = {:g} ({})", *fine_spacing(*m), m->case_id));
       unjudged(finest,
                fmt::format("no finer grid at fidelity {} to refine against ({}){}", level, join(grids, ", "),
                            about_note),

@@ -609,7 +609,7 @@ TEST_F(MotionClaims, TwinDifferenceAgainstTheUniformGrid) {
 TEST_F(MotionClaims, RefinementOfTheStatementsGridAtOneFidelity) {
   const std::string id = "ch2.hovering_wing.refinement";
   json thesis_grid = fixture_case("ch2__hovering_wing_re157");  // the quick run: 1/32
-  thesis_grid["numerics"]["grid"]["fine_spacing"] = 1.0 / 64;    // the grid of the statement
+  thesis_grid["numerics"]["grid"]["fine_spacing"] = 1.0 / 64;   // the grid of the statement
   json finer = thesis_grid, quick = thesis_grid;
   finer["id"] = "ch2/hovering_wing_re157_grid128";
   finer["numerics"]["grid"]["fine_spacing"] = 1.0 / 128;
@@ -648,9 +648,11 @@ TEST_F(MotionClaims, RefinementOfTheStatementsGridAtOneFidelity) {
   const json coarse = moving(id, {moving_run("e", quick, series(1.2), 1e8, "quick"),
                                   moving_run("f", thesis_grid, series(1.0), 1e9, "quick")});
   EXPECT_EQ(coarse["verdict"], "not enough runs") << coarse.dump(2);
-  EXPECT_TRUE(contains(coarse["runs"][0]["note"], "Δx_f = 0.03125 is coarser than the grid the statement is about"))
+  EXPECT_TRUE(
+      contains(coarse["runs"][0]["note"], "Δx_f = 0.03125 is coarser than the grid the statement is about"))
       << coarse["runs"][0];
   EXPECT_TRUE(coarse["runs"][0]["verdict"].is_null());
+  EXPECT_EQ(coarse["runs"][0]["note"].get<std::string>().rfind("Δx_f", 0), 0u);  // the message adds "not judged"
 
   // The statement's grid must be a positive number.
   json bad = moving_claim(id);
