@@ -19,6 +19,7 @@ files', so the type of a value matters: integers stay integers (centre [8, 8], f
 [5, 5]-[11, 11], times), E_b and the wall-time budgets are floats (0.0, 300.0).
 """
 import json
+import math
 
 SERIES = ["taylor_deformation", "inclination", "area_change", "tank_treading_phase", "tank_treading_period"]
 #: With the membrane's length change (total and largest local stretch), where a case scores it.
@@ -61,10 +62,14 @@ def mach(u, domain=16):
 FINE_HALF_WIDTH = 3
 
 
-def fine_region(domain):
-    """The fine block, centred on the capsule at the domain's centre: [5, 5]-[11, 11] for 16a (thesis 3.1.2)."""
+def fine_region(domain, fine_spacing=0.05):
+    """The fine block, centred on the capsule at the domain's centre: [5, 5]-[11, 11] for 16a (thesis 3.1.2).
+    Its faces lie on coarse nodes (caplab's rule): where FINE_HALF_WIDTH is not a whole number of coarse spacings
+    (the fig. 4.3 grids of 2a = 30 and 50 spacings) the block is the smallest one on coarse nodes around it."""
     c = domain // 2
-    return {"min": [c - FINE_HALF_WIDTH] * 2, "max": [c + FINE_HALF_WIDTH] * 2}
+    cells = math.ceil(FINE_HALF_WIDTH / (2 * fine_spacing) - 1e-9)
+    half = FINE_HALF_WIDTH if abs(cells * 2 * fine_spacing - FINE_HALF_WIDTH) < 1e-9 else round(cells * 2 * fine_spacing, 10)
+    return {"min": [c - half] * 2, "max": [c + half] * 2}
 
 
 def setup(re, fine_spacing=0.05, domain=16):
@@ -72,7 +77,7 @@ def setup(re, fine_spacing=0.05, domain=16):
     own grid, domain and relaxation times; the sentence on the quick level follows it (QUICK_HALF unless a case
     says otherwise)."""
     h = fine_spacing
-    region = fine_region(domain)
+    region = fine_region(domain, fine_spacing)
     lo, hi = region["min"][0], region["max"][0]
 
     def taus(u):
@@ -145,16 +150,18 @@ def shorter_run(end_time, average_from):
 def case(cid, title, description, *, shape, G, re, end_time, average_from, Eb=0.0, kappa0="initial", nodes=160,
          domain=16, fine_spacing=0.05, refinement="two_level", walls=False, u=STANDARD_U, snapshots=None,
          series=SERIES, quick=None, quick_speedup=2, quick_keeps_nodes=False, quick_end=None,
-         quick_snapshots=None, quick_average_from=None, thesis=THESIS_LEVEL, acceptance=(), performance=None):
+         quick_snapshots=None, quick_average_from=None, thesis=THESIS_LEVEL, magic=None, acceptance=(),
+         performance=None):
     """One case file. `cid` is "chapter/name"; `shape` the shape's type and parameters (the centre and the
     equivalent diameter 2 are added); walls=True: moving walls at y = 0 and y = domain with x periodic instead
     of the far field on all faces; quick=None: the default half-resolution quick level (with the quick_*
-    options), else the quick block itself."""
+    options), else the quick block itself; magic: the TRT magic parameter where a case sets its own (the
+    thesis level's cases take the thesis's, thesis_magic)."""
     assert domain % 2 == 0  # the centre stays an integer
     snapshots = list(snapshots) if snapshots else [end_time]
     grid = {"refinement": refinement, "fine_spacing": fine_spacing}
     if refinement == "two_level":
-        grid["fine_region"] = fine_region(domain)
+        grid["fine_region"] = fine_region(domain, fine_spacing)
     if quick is None:
         quick = {"numerics.grid.fine_spacing": 2 * fine_spacing, "numerics.lattice_velocity": quick_speedup * u}
         if not quick_keeps_nodes:
@@ -163,6 +170,9 @@ def case(cid, title, description, *, shape, G, re, end_time, average_from, Eb=0.
         quick["outputs.snapshots.times"] = snapshots if quick_snapshots is None else quick_snapshots
         if quick_average_from is not None:
             quick["outputs.average_from"] = quick_average_from
+    if magic is None and thesis == THESIS_LEVEL:
+        magic = thesis_magic(re, fine_spacing)
+    collision = {"operator": "trt"} if magic is None else {"operator": "trt", "magic": magic}
     doc = {
         "id": cid,
         "title": title,
@@ -181,8 +191,7 @@ def case(cid, title, description, *, shape, G, re, end_time, average_from, Eb=0.
         },
         "numerics": {
             "grid": grid,
-            "collision": ({"operator": "trt", "magic": thesis_magic(re, fine_spacing)} if thesis == THESIS_LEVEL
-                          else {"operator": "trt"}),
+            "collision": collision,
             "precision": "double",
             "ib": {"kernel": "cosine4"},
             "lattice_velocity": u,
