@@ -71,6 +71,7 @@ OBLATE_SMALL_SWING = dict(oscillation_threshold=0.25, note=(
     "the default's 2 degrees, while the NH sphere's wobble at G = 0.2 (the discrete membrane turning) is 0.23 degrees "
     "peak to peak (ch5/sphere_nh_G0.2, standard)."))
 
+
 def case(cid, title, description, *, chapter="ch5", shape, law, G, re, domain, fine, fine_per_a, subdivisions,
          end_time, average_from, walls=False, C=None, refinement="two_level", tau_f=3.5,
          acceptance=(), quick_end=None, snapshots=(), quick_speedup=2, performance=None, quick_margin=0,
