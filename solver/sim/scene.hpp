@@ -763,28 +763,7 @@ class Scene {
                              "velocity raises it)",
                              b.name, E_lu, limit, D);
       }
-    if (tau < 0.55) {
-      // At a fixed Re and grid, tau - 1/2 = 3 U_lu (L/dx) / Re: a lower lattice velocity moves tau
-      // closer to 1/2, a higher one (Mach allowing) or a finer grid moves it away.
-      const auto& col = spec_.numerics.collision;
-      const double magic_for_unit_tau_minus = (tau - 0.5) / 2;
-      const std::string remedy =
-          col.op == cases::CollisionSpec::Operator::bgk
-              ? std::string("use the TRT operator (numerics.collision.operator = \"trt\"),")
-          : col.magic <= magic_for_unit_tau_minus
-              ? fmt::format("TRT's odd moments already relax fast here (tau- = {:.3g}, magic {:.3g}); what is left is",
-                            collision::Trt{tau, col.magic}.tau_minus(), col.magic)
-              : fmt::format("with TRT the odd moments relax with tau- = 1/2 + magic / (tau - 1/2) = {:.3g}, slowly, "
-                            "and the errors the refinement interface or the immersed boundary put there persist: "
-                            "a smaller numerics.collision.magic, down to (tau - 1/2)/2 = {:.3g}, which gives tau- = 1 "
-                            "(measured: chapter 4 at Re 100, tau = 0.512, diverged with magic 1/4 and 1/12, tau- = 21 "
-                            "and 7.4, and runs with 0.01, tau- = 1.3),",
-                            collision::Trt{tau, col.magic}.tau_minus(), magic_for_unit_tau_minus);
-      return fmt::format("tau = {:.4f} on this block is close to 1/2 for this Reynolds number and grid; {} a finer "
-                         "grid or a higher numerics.lattice_velocity (tau - 1/2 grows with it at a fixed Re, as far as "
-                         "the Mach number allows)",
-                         tau, remedy);
-    }
+    if (tau < 0.55) return tau_near_half_cause(spec_.numerics.collision, tau);
     return fmt::format("the lattice velocity {:.3g} is too high for this flow (compressibility): lower "
                        "numerics.lattice_velocity",
                        units_.velocity_lu);

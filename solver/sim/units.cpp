@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 
+#include "collision/operators.hpp"
 #include "core/error.hpp"
 
 namespace caplab::sim {
@@ -259,6 +260,30 @@ double membrane_stiffness_factor(const cases::MembraneSpec& membrane) {
 double membrane_lattice_modulus(const LatticeUnits& units, const cases::BodySpec& body) {
   return units.blocks.back().nu_lu * units.velocity_lu / body.membrane->capillary *
          membrane_stiffness_factor(*body.membrane);
+}
+
+std::string tau_near_half_cause(const cases::CollisionSpec& collision, double tau) {
+  // At a fixed Re and grid, tau - 1/2 = 3 U_lu (L/dx) / Re: a lower lattice velocity moves tau
+  // closer to 1/2, a higher one (Mach allowing) or a finer grid moves it away.
+  const double tau_minus = collision::Trt{tau, collision.magic}.tau_minus();
+  const double magic_for_unit_tau_minus = (tau - 0.5) / 2;
+  std::string remedy;
+  if (collision.op == cases::CollisionSpec::Operator::bgk)
+    remedy = "use the TRT operator (numerics.collision.operator = \"trt\"), ";
+  else if (collision.magic > magic_for_unit_tau_minus)
+    remedy = fmt::format(
+        "with TRT the odd moments relax with tau- = 1/2 + magic / (tau - 1/2) = {:.3g}, slowly, and the errors the "
+        "refinement interface or the immersed boundary put there persist: a smaller numerics.collision.magic, down to "
+        "(tau - 1/2)/2 = {:.3g}, which gives tau- = 1 (measured: chapter 4 at Re 100, tau = 0.512, diverged with magic "
+        "1/4 and 1/12, tau- = 21 and 7.4, and runs with 0.01, tau- = 1.3), ",
+        tau_minus, magic_for_unit_tau_minus);
+  else
+    remedy = fmt::format("TRT's odd moments already relax fast here (magic {:.3g}, tau- = {:.3g}); what is left is ",
+                         collision.magic, tau_minus);
+  return fmt::format("tau = {:.4f} on this block is close to 1/2 for this Reynolds number and grid; {}a finer grid or "
+                     "a higher numerics.lattice_velocity (tau - 1/2 grows with it at a fixed Re, as far as the Mach "
+                     "number allows)",
+                     tau, remedy);
 }
 
 }  // namespace caplab::sim

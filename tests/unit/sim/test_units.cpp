@@ -218,5 +218,28 @@ TEST(sim_units, NoCatalogueMembraneIsAboveTheExplicitCouplingLimit) {
   EXPECT_GT(membranes, 300);
 }
 
+// The advice for a block whose tau is close to 1/2 names what to change for the case's operator:
+// TRT for BGK; for TRT a magic parameter down to (tau - 1/2)/2 (tau- = 1), and never a larger one
+// than the case already has.
+TEST(TauNearHalfCause, NamesTheChangeForTheOperator) {
+  using Op = cases::CollisionSpec::Operator;
+  const double tau = 0.51875;  // the cylinder at Re 200, quick, coarse block
+  const std::string bgk = tau_near_half_cause({Op::bgk, 0.25}, tau);
+  EXPECT_NE(bgk.find("use the TRT operator"), std::string::npos) << bgk;
+
+  const std::string trt = tau_near_half_cause({Op::trt, 1.0 / 12}, tau);
+  EXPECT_NE(trt.find("tau- = 1/2 + magic / (tau - 1/2) = 4.94"), std::string::npos) << trt;
+  EXPECT_NE(trt.find("down to (tau - 1/2)/2 = 0.00938, which gives tau- = 1"), std::string::npos) << trt;
+
+  const std::string small = tau_near_half_cause({Op::trt, 0.005}, tau);
+  EXPECT_EQ(small.find("a smaller numerics.collision.magic"), std::string::npos) << small;
+  EXPECT_NE(small.find("already relax fast here (magic 0.005, tau- = 0.767)"), std::string::npos) << small;
+
+  for (const auto& s : {bgk, trt, small}) {
+    EXPECT_EQ(s.rfind("tau = 0.5188 on this block is close to 1/2", 0), 0u) << s;
+    EXPECT_NE(s.find("a finer grid or a higher numerics.lattice_velocity"), std::string::npos) << s;
+  }
+}
+
 }  // namespace
 }  // namespace caplab::sim
