@@ -13,7 +13,7 @@ namespace caplab::collision {
 
 /// c_i · v. Only the nonzero components of c_i take part: a product with the constant 0 is not
 /// folded away in IEEE arithmetic (−0, NaN), and after unrolling the tests are on constants
-/// and vanish. Σ_a c_ia v_a cost each D3Q19 node 33 multiplications by zero per sum.
+/// and vanish. Σ_a c_ia v_a cost each D3Q19 node 27 multiplications by zero per sum.
 template <class L, class T>
 [[gnu::always_inline]] inline T c_dot(int i, const T (&v)[L::d]) {
   T s = 0;
