@@ -64,7 +64,7 @@ def stable_time_step(re, a_lu, G, law, C=None, tau_f=3.5):
 
 OBLATE_SMALL_SWING = dict(oscillation_threshold=0.25, note=(
     "Swinging counts from a 0.5-degree reversal (outputs.oscillation_threshold 0.25, against the default 1): the nearly "
-    "spherical capsule at this G swings by 1.27 degrees peak to peak (ch5, theta 0.3503-0.3724 rad, D 0.499-0.523, "
+    "spherical capsule at this G swings by 1.27 degrees peak to peak (ch5, theta 20.07-21.34 degrees, D 0.499-0.523, "
     "period about 10/k; ch6 to k t = 40, theta 20.04-21.35 degrees, period about 12/k; standard, 2026-12-05), below "
     "the default's 2 degrees, while the NH sphere's wobble at G = 0.2 (the discrete membrane turning) is 0.23 degrees "
     "peak to peak (ch5/sphere_nh_G0.2, standard)."))

@@ -54,9 +54,9 @@ LatticeUnits derive_units(const cases::CaseSpec& spec);
 
 /// Why a block whose tau is close to 1/2 (below 0.55) diverged and what to change, as the cause
 /// sentence of a numerical-instability error. BGK: use TRT. TRT with a magic parameter above
-/// (tau - 1/2)/2: lower it to that value, which gives tau- = 1 (measured: chapter 4 at Re 100,
-/// tau = 0.512, diverged with 1/4 and 1/12 and runs with 0.01). Always: a finer grid or a higher
-/// lattice velocity, which move tau away from 1/2.
+/// (tau - 1/2)/2: lower it to that value, which gives tau- = 1 (the message quotes the chapter 4
+/// measurement behind it). Always: a finer grid or a higher lattice velocity, which move tau away
+/// from 1/2.
 std::string tau_near_half_cause(const cases::CollisionSpec& collision, double tau);
 
 /// Bytes a run of `spec` on `blocks` allocates for what scales with the lattice: populations
