@@ -108,8 +108,8 @@ double timed_steps(Fluid& fluid, long steps) {
   return now_seconds() - t0;
 }
 
-/// Batch length (steps) for about 1/5 of the minimum time, after one warm-up step (the first
-/// touch of the next buffer happens there) and one timed step.
+/// Batch length (steps) for about 1/5 of the minimum time, after one warm-up step and one
+/// timed step.
 template <class Fluid>
 long batch_steps(Fluid& fluid, double min_seconds) {
   fluid.step();

@@ -1,6 +1,8 @@
 // Boundary conditions of a block, applied through its ghost layer after the fused kernel.
 //
-// After collide-and-push, the interior slots whose source is a ghost node are empty. Each
+// After collide-and-push, the interior slots whose source is a ghost node are empty (slots
+// addressed at the new parity, field/populations.hpp: the slot of population i entering
+// interior node t, and the one where interior node s left population i that went out). Each
 // ghost node has one owner (the first of interface > wall > far field > periodic among
 // the axes along which it lies outside the interior), and the owner fills those slots:
 //  - periodic: the population that left through the opposite face (a copy);
@@ -14,12 +16,15 @@
 //    distribution function is set at its equilibrium state"): the ghost node holds
 //    f_eq(ρ0 = 1, u_b), so what enters is the unperturbed far-field state, whatever leaves;
 //  - interface: left to the multi-block coupling (refinement module).
-// All links are precomputed once; applying them touches only the block surface.
-// Far-field ghosts are stored as structure of arrays in memory order and processed in
-// batches: one vector loop over a batch computes all Q post-collision values of each ghost,
-// then a scalar loop writes the links. Every entering slot has exactly one source ghost, so
-// the result does not depend on the order or the batching. Periodic and wall copies read ghost
-// slots only and write interior slots only: they run in parallel in any order.
+// All links are precomputed once, the copies as buffer indices for either parity; applying
+// them touches only the block surface. Far-field ghosts are stored as structure of arrays in
+// memory order. Their post-collision values are computed before the sweep (prepare(): the
+// extrapolation reads the interior at time t, which the in-place sweep overwrites; the
+// equilibrium values are constant and computed once), in batches, one vector loop computing all
+// Q values of each ghost of a batch; apply() writes them along the links. Every entering slot
+// has exactly one source, so the result does not depend on the order or the batching. Periodic
+// and wall copies read slots of leaving populations only and write entering slots only: they
+// run in parallel in any order.
 #pragma once
 
 #include <functional>
@@ -55,39 +60,46 @@ class BoundarySet {
     pad_far_field();
   }
 
-  /// Fills the interior slots entering from the ghost layer, in pop.next().
-  /// Reads pop.current() (time t) for the far-field extrapolation.
+  /// Before the sweep: the far-field ghosts' post-collision values from the state at time t
+  /// (Guo's extrapolation; nothing to do for the constant equilibrium).
   template <class Op>
-  void apply(field::Populations<L, T>& pop, const Op& op) const {
-    T* next = pop.next();
-    const std::ptrdiff_t N = pop.grid().size();
-    // A copy reads a ghost slot and writes an interior slot, so the copies are independent.
-    // Serial, they took 8 % of a quick biconcave step on one thread (perf; periodic in x and y,
-    // walls in z), with any other thread waiting.
-    const Copy* copies = copies_.data();
-    const std::ptrdiff_t n_copies = static_cast<std::ptrdiff_t>(copies_.size());
-#pragma omp parallel for schedule(static) if (n_copies > 4096)
-    for (std::ptrdiff_t k = 0; k < n_copies; ++k)
-      next[copies[k].dst] = next[copies[k].src] + T(copies[k].add);
-    const T* current = pop.current();
+  void prepare(const field::Populations<L, T>& pop, const Op& op) {
+    if (far_field_ != FarField::extrapolation) return;
+    const auto bases = pop.bases();
     const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(far_interior_.size()) / batch;
-    if (far_field_ == FarField::equilibrium) {
 #pragma omp parallel for schedule(static)
-      for (std::ptrdiff_t b = 0; b < batches; ++b) far_field_batch<true>(current, next, N, op, b * batch);
-    } else {
-#pragma omp parallel for schedule(static)
-      for (std::ptrdiff_t b = 0; b < batches; ++b) far_field_batch<false>(current, next, N, op, b * batch);
-    }
+    for (std::ptrdiff_t b = 0; b < batches; ++b) far_field_batch<false>(bases, op, b * batch);
   }
 
-  bool empty() const { return copies_.empty() && far_interior_.empty(); }
+  /// After the sweep (and its parity flip): fills the interior slots entering from the ghost
+  /// layer.
+  void apply(field::Populations<L, T>& pop) const {
+    T* data = pop.data();
+    // A copy reads a leaving slot and writes an entering slot, so the copies are independent.
+    // Serial, they took 8 % of a quick biconcave step on one thread (perf; periodic in x and y,
+    // walls in z), with any other thread waiting.
+    const Copy* copies = copies_[pop.parity()].data();
+    const std::ptrdiff_t n_copies = static_cast<std::ptrdiff_t>(copies_[pop.parity()].size());
+#pragma omp parallel for schedule(static) if (n_copies > 4096)
+    for (std::ptrdiff_t k = 0; k < n_copies; ++k)
+      data[copies[k].dst] = data[copies[k].src] + T(copies[k].add);
+    const auto P = pop.bases();
+    const std::ptrdiff_t K = static_cast<std::ptrdiff_t>(far_interior_.size());
+    const T* post = far_post_.data();
+#pragma omp parallel for schedule(static) if (K > 4096)
+    for (std::ptrdiff_t k = 0; k < K; ++k)
+      for (int l = far_first_link_[k]; l < far_first_link_[k + 1]; ++l)
+        P[far_links_[l].i][far_links_[l].dst] = post[far_links_[l].i * K + k];
+  }
+
+  bool empty() const { return copies_[0].empty() && far_interior_.empty(); }
 
  private:
   /// Far-field ghosts per vector loop: one 64-byte cache line of T.
   static constexpr int batch = static_cast<int>(64 / sizeof(T));
 
   struct Copy {
-    std::ptrdiff_t dst, src;  // full slot indices i·N + node
+    std::ptrdiff_t dst, src;  // buffer indices (Populations::slot) at one parity
     double add;
   };
   struct Link {
@@ -95,12 +107,13 @@ class BoundarySet {
     std::ptrdiff_t dst;  // interior node receiving population i
   };
 
-  /// The post-collision state of ghosts k0 … k0 + batch − 1 (Guo's extrapolation and the
-  /// collision, or the far-field equilibrium, a fixed point of the collision), then their links.
+  /// The post-collision state of ghosts k0 … k0 + batch − 1 into far_post_ (Guo's extrapolation
+  /// from the state `current` and the collision, or the far-field equilibrium, a fixed point of
+  /// the collision).
   template <bool Equilibrium, class Op>
-  void far_field_batch(const T* __restrict current, T* __restrict next, std::ptrdiff_t N, const Op& op,
-                       std::ptrdiff_t k0) const {
-    T post[Q][batch];
+  void far_field_batch(const std::array<const T*, Q>& current, const Op& op, std::ptrdiff_t k0) {
+    const std::ptrdiff_t K = static_cast<std::ptrdiff_t>(far_interior_.size());
+    T* post = far_post_.data();
 #pragma omp simd
     for (int b = 0; b < batch; ++b) {
       T out[Q], ub[D];
@@ -112,7 +125,7 @@ class BoundarySet {
         // A 32-bit node index into population i's array: GCC 12 turns it into a vector gather;
         // a 64-bit index into the whole buffer leaves the loop scalar.
 #pragma GCC unroll 19
-        for (int i = 0; i < Q; ++i) f[i] = (current + i * N)[far_interior_[k0 + b]];
+        for (int i = 0; i < Q; ++i) f[i] = current[i][far_interior_[k0 + b]];
         collision::moments<L, T>(f, rho, u);
         collision::equilibrium<L, T>(rho, u, feq_f);
         collision::equilibrium<L, T>(rho, ub, feq_b);
@@ -121,11 +134,8 @@ class BoundarySet {
         op.template collide<L, T>(fb, feq_b, out);
       }
 #pragma GCC unroll 19
-      for (int i = 0; i < Q; ++i) post[i][b] = out[i];
+      for (int i = 0; i < Q; ++i) post[i * K + k0 + b] = out[i];
     }
-    for (int b = 0; b < batch; ++b)
-      for (int l = far_first_link_[k0 + b]; l < far_first_link_[k0 + b + 1]; ++l)
-        next[far_links_[l].i * N + far_links_[l].dst] = post[far_links_[l].i][b];
   }
 
   void add_ghost(const field::Grid<D>& g, const std::array<Kind, D>& kinds, const VelocityField& imposed,
@@ -135,7 +145,6 @@ class BoundarySet {
     for (int a = 0; a < D; ++a)
       if ((h[a] < 0 || h[a] >= g.n()[a]) && rank(kinds[a]) > rank(owner)) owner = kinds[a];
     if (owner == Kind::interface) return;
-    const std::ptrdiff_t N = g.size();
     const int first = static_cast<int>(far_links_.size());
     for (int i = 0; i < Q; ++i) {
       Index<D> t;
@@ -147,14 +156,13 @@ class BoundarySet {
           if (h[a] < 0) src[a] += g.n()[a];
           if (h[a] >= g.n()[a]) src[a] -= g.n()[a];
         }
-        copies_.push_back({i * N + g.index(t), i * N + g.index(src), 0.0});
+        add_copy(g, i, g.index(t), i, g.index(src), 0.0);
       } else if (owner == Kind::wall) {
         const Vec<D> x_wall = 0.5 * (g.position(h) + g.position(t));
         const Vec<D> u_w = imposed(x_wall);
         double cu = 0;
         for (int a = 0; a < D; ++a) cu += L::c[i][a] * u_w[a];
-        const int o = L::opposite[i];
-        copies_.push_back({i * N + g.index(t), o * N + g.index(h), 2.0 * L::w[i] * cu / L::cs2});
+        add_copy(g, i, g.index(t), L::opposite[i], g.index(h), 2.0 * L::w[i] * cu / L::cs2);
       } else {
         far_links_.push_back({i, g.index(t)});
       }
@@ -169,8 +177,16 @@ class BoundarySet {
     }
   }
 
-  /// Fills the last batch with copies of the last ghost that own no links, and closes the
-  /// link ranges.
+  /// Entering population i of interior node t ← population j of node g (as the A–B pattern
+  /// addressed them in the buffer after the push: the slot where it left, g a ghost or, for a
+  /// wall, g = t − c_i with j = ī) + add, for both parities after the sweep.
+  void add_copy(const field::Grid<D>& g, int i, std::ptrdiff_t t, int j, std::ptrdiff_t src, double add) {
+    using Pop = field::Populations<L, T>;
+    for (int p = 0; p < 2; ++p) copies_[p].push_back({Pop::slot(g, p, i, t), Pop::slot(g, p, j, src), add});
+  }
+
+  /// Fills the last batch with copies of the last ghost that own no links, closes the link
+  /// ranges, and sizes the post-collision values (the constant far-field equilibrium: now).
   void pad_far_field() {
     while (!far_interior_.empty() && far_interior_.size() % batch != 0) {
       far_interior_.push_back(far_interior_.back());
@@ -178,10 +194,15 @@ class BoundarySet {
       far_first_link_.push_back(static_cast<int>(far_links_.size()));
     }
     far_first_link_.push_back(static_cast<int>(far_links_.size()));
+    far_post_.assign(Q * far_interior_.size(), T(0));
+    if (far_field_ == FarField::equilibrium) {
+      struct NoCollision {} none;
+      for (std::size_t b = 0; b < far_interior_.size() / batch; ++b) far_field_batch<true>({}, none, b * batch);
+    }
   }
 
   FarField far_field_ = FarField::extrapolation;
-  std::vector<Copy> copies_;
+  std::array<std::vector<Copy>, 2> copies_;  // by the parity after the sweep
   // Far-field ghosts in the order of the ghost layer (memory order), padded to whole batches:
   // nearest interior node (extrapolation source), imposed velocity u_b, and the links of
   // ghost k, far_links_[far_first_link_[k] … far_first_link_[k + 1]).
@@ -189,6 +210,7 @@ class BoundarySet {
   std::array<std::vector<T>, D> far_u_b_;
   std::vector<int> far_first_link_;
   std::vector<Link> far_links_;
+  field::AlignedVector<T> far_post_;  // [i][k]: ghost k's post-collision population i
 };
 
 }  // namespace caplab::boundary

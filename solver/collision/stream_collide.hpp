@@ -1,10 +1,11 @@
-// The fused collide-and-push kernel of one block (thesis eq. 2.1 and 2.23).
+// The fused collide-and-push kernel of one block (thesis eq. 2.1 and 2.23), in place.
 //
 // One pass over the interior: read the Q shifted populations of a node (pre-collision,
-// time t), compute ρ and u (with half the force when forced), the equilibrium, collide,
-// and push post-collision value i to the neighbour along c_i in the other buffer. Pushes
-// that leave the interior land in the ghost layer, where the boundary stages pick them up;
-// populations entering the interior from outside are written by those stages.
+// time t), compute ρ and u (with half the force when forced), the equilibrium, collide, and
+// write the post-collision values back into the node's own Q slots, where the next step finds
+// them as its neighbours' populations (the AA pattern, field/populations.hpp). Pushes that
+// leave the interior land in ghost slots, where the boundary stages pick them up; populations
+// entering the interior from outside are written by those stages after the sweep.
 // The force term is compiled away for unforced blocks (Forced = false).
 // Rows (x lines) are distributed over OpenMP threads; the x loop is straight-line code.
 #pragma once
@@ -52,34 +53,33 @@ inline void collide_forced(const T (&f)[L::q], const T (&F)[L::d], const Op& op,
 template <class T>
 inline constexpr int simd_chunk = static_cast<int>(64 / sizeof(T));
 
-/// Cache lines ahead that the fused kernel prefetches on each of its 2Q streams. The hardware
+/// Cache lines ahead that the fused kernel prefetches on each of its Q streams. The hardware
 /// prefetchers do not keep up with 19 read and 19 write streams: measured on one thread
-/// (harness of the kernel alone, 128^3, D3Q19 BGK, AMD Zen 5, 2026-12-04), double 60 -> 98
-/// MLUPS and single 106 -> 198 with 6 lines; 4 to 10 lines are all within 5 % of that.
+/// (harness of the kernel alone, 128^3, D3Q19 BGK, AMD Zen 5, 2026-12-04, A–B pattern),
+/// double 60 -> 98 MLUPS and single 106 -> 198 with 6 lines; 4 to 10 lines are all within
+/// 5 % of that.
 inline constexpr int prefetch_lines = 6;
 
-/// Prefetches population i of node n in src (for reading) and its push target in dst (for
-/// writing) for every i: lines the kernel reaches prefetch_lines chunks later.
+/// Prefetches, for writing, population i of node n for every i: the slots the kernel reads
+/// and writes back prefetch_lines chunks later.
 template <int Q, class T>
-[[gnu::always_inline]] inline void prefetch_node(const T* src, T* dst, std::ptrdiff_t N, const std::ptrdiff_t (&off)[Q],
-                                                 std::ptrdiff_t n) {
+[[gnu::always_inline]] inline void prefetch_node(T* const (&P)[Q], std::ptrdiff_t n) {
 #pragma GCC unroll 19
-  for (int i = 0; i < Q; ++i) {
-    __builtin_prefetch(src + i * N + n, 0, 3);
-    __builtin_prefetch(dst + i * N + n + off[i], 1, 3);
-  }
+  for (int i = 0; i < Q; ++i) __builtin_prefetch(P[i] + n, 1, 3);
 }
 
-/// Collide-and-push of node n (the body of the fused kernel's vector loop). Scalars and
-/// references to C arrays only, so that GCC vectorizes the loop that calls it.
+/// Collide-and-push of node n in place (the body of the fused kernel's vector loop): reads
+/// f_i from P[i][n], writes the post-collision value i to P[ī][n] (field/populations.hpp: the
+/// same Q slots, and where the next step at the other parity finds it at node n + c_i).
+/// `store` false leaves the slots untouched (a lane of a chunk that was already updated).
+/// Scalars and references to C arrays only, so that GCC vectorizes the loop that calls it.
 template <bool Forced, class L, class T, class Op>
-[[gnu::always_inline]] inline void update_node(const T* __restrict src, T* __restrict dst, std::ptrdiff_t N,
-                                               const std::ptrdiff_t (&off)[L::q], const Op& op,
-                                               const double* const (&fp)[L::d], std::ptrdiff_t n) {
+[[gnu::always_inline]] inline void update_node(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
+                                               std::ptrdiff_t n, bool store = true) {
   constexpr int Q = L::q, D = L::d;
   T f[Q], feq[Q], out[Q], rho, u[D];
 #pragma GCC unroll 19
-  for (int i = 0; i < Q; ++i) f[i] = src[i * N + n];
+  for (int i = 0; i < Q; ++i) f[i] = P[i][n];
   if constexpr (Forced) {
     T F[D];
     for (int a = 0; a < D; ++a) F[a] = T(fp[a][n]);
@@ -89,29 +89,26 @@ template <bool Forced, class L, class T, class Op>
     equilibrium<L, T>(rho, u, feq);
     op.template collide<L, T>(f, feq, out);
   }
+  if (store) {
 #pragma GCC unroll 19
-  for (int i = 0; i < Q; ++i) dst[i * N + n + off[i]] = out[i];
+    for (int i = 0; i < Q; ++i) P[L::opposite[i]][n] = out[i];
+  }
 }
 
-/// One time step of the fluid on a block: collide and stream into `next()`, no swap.
-/// `force` (lattice units, per node) must be non-null exactly when Forced is true.
+/// The in-place sweep of one time step over the interior of a block, without the parity flip
+/// (stream_collide and stream_collide_forced_at flip it).
 ///
 /// Each row runs in chunks of simd_chunk<T> nodes with a trip count known at compile time, so
 /// the whole row is vector code; the last chunk is shifted back to end at the row's end and
-/// redoes a few nodes, which is harmless: a node's update reads only current() and writes the
-/// same values to next() each time. (A row of 47 nodes, the fine block of a chapter 5 sphere,
-/// otherwise ends in a 15-node scalar remainder: measured 51 MLUPS at 47^3 against 128 at 48^3,
-/// D3Q19 TRT single, 2 threads.)
+/// does not store the lanes that the chunk before already updated (masked stores: in place, a
+/// node updated twice would collide its own output). (A row of 47 nodes, the fine block of a
+/// chapter 5 sphere, otherwise ends in a 15-node scalar remainder: measured 51 MLUPS at 47^3
+/// against 128 at 48^3, D3Q19 TRT single, 2 threads.)
 template <bool Forced, class L, class T, class Op>
-void stream_collide(field::Populations<L, T>& pop, const Op& op,
-                    const field::VectorField<L::d, double>* force = nullptr) {
+void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>* force) {
   constexpr int Q = L::q, D = L::d, W = simd_chunk<T>;
   const auto& g = pop.grid();
-  const std::ptrdiff_t N = g.size();
-  std::array<std::ptrdiff_t, Q> off;
-  for (int i = 0; i < Q; ++i) off[i] = g.offset(L::c[i]);
-  const T* __restrict src = pop.current();
-  T* __restrict dst = pop.next();
+  const std::array<T*, Q> P = pop.bases();
   std::array<const double*, D> fp{};
   if constexpr (Forced)
     for (int a = 0; a < D; ++a) fp[a] = force->comp[a].data();
@@ -119,28 +116,43 @@ void stream_collide(field::Populations<L, T>& pop, const Op& op,
   parallel_rows<D>(g, [&](std::ptrdiff_t base, int nx) {
     // Loop invariants in locals: read through the closure they are reloaded every iteration
     // and GCC does not vectorize the loop (measured: D3Q19 double 42 -> 94 MLUPS, 2 threads).
-    const T* __restrict src_l = src;
-    T* __restrict dst_l = dst;
-    const std::ptrdiff_t N_l = N;
-    std::ptrdiff_t off_l[Q];
-    for (int i = 0; i < Q; ++i) off_l[i] = off[i];
+    T* P_l[Q];
+    for (int i = 0; i < Q; ++i) P_l[i] = P[i];
     const Op op_l = op;
     const double* fp_l[D];
     for (int a = 0; a < D; ++a) fp_l[a] = fp[a];
     if (nx < W) {
 #pragma omp simd
-      for (int x = 0; x < nx; ++x) update_node<Forced, L, T>(src_l, dst_l, N_l, off_l, op_l, fp_l, base + x);
+      for (int x = 0; x < nx; ++x) update_node<Forced, L, T>(P_l, op_l, fp_l, base + x);
       return;
     }
-    for (int x0 = 0; x0 < nx; x0 += W) {
-      const std::ptrdiff_t chunk = base + std::min(x0, nx - W);
+    const int whole = nx - nx % W;
+    for (int x0 = 0; x0 < whole; x0 += W) {
+      const std::ptrdiff_t chunk = base + x0;
       // Past the row's end this reaches the next rows, contiguous in memory (x fastest), which
       // this thread takes next under the static schedule; past the array's end it is harmless.
-      prefetch_node<Q>(src_l, dst_l, N_l, off_l, chunk + prefetch_lines * W);
+      prefetch_node<Q>(P_l, chunk + prefetch_lines * W);
 #pragma omp simd
-      for (int x = 0; x < W; ++x) update_node<Forced, L, T>(src_l, dst_l, N_l, off_l, op_l, fp_l, chunk + x);
+      for (int x = 0; x < W; ++x) update_node<Forced, L, T>(P_l, op_l, fp_l, chunk + x);
+    }
+    if (whole < nx) {
+      const std::ptrdiff_t chunk = base + nx - W;
+      const int done = whole - (nx - W);  // lanes the last whole chunk updated
+#pragma omp simd
+      for (int x = 0; x < W; ++x) update_node<Forced, L, T>(P_l, op_l, fp_l, chunk + x, x >= done);
     }
   });
+}
+
+/// One time step of the fluid on a block, in place: collide and push every interior node, then
+/// flip the parity. Populations entering the interior from the ghost layer are left to the
+/// boundary stages, which run after it (they address the new parity).
+/// `force` (lattice units, per node) must be non-null exactly when Forced is true.
+template <bool Forced, class L, class T, class Op>
+void stream_collide(field::Populations<L, T>& pop, const Op& op,
+                    const field::VectorField<L::d, double>* force = nullptr) {
+  sweep<Forced>(pop, op, force);
+  pop.flip_parity();
 }
 
 /// Runs body(k) for every k in [0, count): whole chunks of W consecutive k as one `omp simd`
@@ -169,9 +181,11 @@ template <int W, class Body>
   }
 }
 
-/// Consecutive linear indices [begin, end) inside one row's interior, at least one chunk long.
+/// Consecutive linear indices [begin, end) inside one row's interior, at least one chunk long;
+/// `first` numbers its nodes densely across the spans of a region (node begin + j is number
+/// first + j), for per-node scratch such as the forced collision's results.
 struct NodeSpan {
-  std::ptrdiff_t begin, end;
+  std::ptrdiff_t begin, end, first = 0;
 };
 
 /// The nodes a forcing stage visits: distinct interior nodes in memory order and, where the
@@ -180,6 +194,10 @@ struct ForcedRegion {
   std::span<const std::ptrdiff_t> nodes;
   std::span<const NodeSpan> spans;
   bool empty() const { return nodes.empty(); }
+  /// Nodes the walkers visit: the spans' nodes, or the listed ones (the dense numbering).
+  std::ptrdiff_t visited() const {
+    return spans.empty() ? static_cast<std::ptrdiff_t>(nodes.size()) : spans.back().first + spans.back().end - spans.back().begin;
+  }
 };
 
 /// Covers the sorted distinct interior nodes `nodes` of grid g with spans of at least W nodes,
@@ -189,7 +207,7 @@ struct ForcedRegion {
 /// Nodes of one row less than 2W apart share a span (the nodes between are visited too); a
 /// span shorter than W grows to W inside its row, backwards at the row's end. Spans are
 /// disjoint: two spans of one row are at least 2W − 1 apart before growing and each grows by
-/// less than W. Leaves `spans` empty when the rows are shorter than W. W is the walker's chunk
+/// less than W; their nodes are numbered densely in order (NodeSpan::first). Leaves `spans` empty when the rows are shorter than W. W is the walker's chunk
 /// (for_each_in_spans<W>, a span shorter than it would be overrun): both take it at compile
 /// time, simd_chunk<T> of the populations.
 template <int W, int D>
@@ -207,14 +225,15 @@ void cover_with_spans(const field::Grid<D>& g, std::span<const std::ptrdiff_t> n
       begin = std::min(begin, row_hi - W);
       end = begin + W;
     }
-    spans.push_back({begin, end});
+    const std::ptrdiff_t first = spans.empty() ? 0 : spans.back().first + spans.back().end - spans.back().begin;
+    spans.push_back({begin, end, first});
   }
 }
 
-/// Runs body(n) for every node n of the spans (cover_with_spans<W>): each span as whole chunks
-/// of W consecutive nodes, one `omp simd` loop each, the last shifted back to end at the span's
-/// end (it redoes nodes, so body(n) must write the same values each time and nothing another
-/// node reads); the spans in parallel (they are disjoint).
+/// Runs body(n, k) for every node n of the spans (cover_with_spans<W>), k its dense number:
+/// each span as whole chunks of W consecutive nodes, one `omp simd` loop each, the last shifted
+/// back to end at the span's end (it redoes nodes, so body must write the same values each time
+/// and nothing another node reads); the spans in parallel (they are disjoint).
 template <int W, class Body>
 [[gnu::always_inline]] inline void for_each_in_spans(std::span<const NodeSpan> spans, const Body& body) {
   const auto count = static_cast<std::ptrdiff_t>(spans.size());
@@ -223,14 +242,16 @@ template <int W, class Body>
     const NodeSpan span = spans[s];
     for (std::ptrdiff_t c0 = span.begin; c0 < span.end; c0 += W) {
       const std::ptrdiff_t c = std::min(c0, span.end - W);
+      const std::ptrdiff_t k = span.first + (c - span.begin);
 #pragma omp simd
-      for (int j = 0; j < W; ++j) body(c + j);
+      for (int j = 0; j < W; ++j) body(c + j, k + j);
     }
   }
 }
 
-/// body(n) for the nodes of `region`: over its spans where it has them, otherwise over the node
-/// list (for_each_in_chunks, gathers and scatters).
+/// body(n, k) for the nodes of `region`, k the dense number of n (ForcedRegion::visited): over
+/// its spans where it has them, otherwise over the node list (for_each_in_chunks, gathers and
+/// scatters).
 template <int W, class Body>
 [[gnu::always_inline]] inline void for_each_forced_node(const ForcedRegion& region, const Body& body) {
   if (!region.spans.empty()) {
@@ -238,33 +259,47 @@ template <int W, class Body>
     return;
   }
   const std::ptrdiff_t* node = region.nodes.data();
-  auto listed = [&](std::ptrdiff_t k) __attribute__((always_inline)) { body(node[k]); };
+  auto listed = [&](std::ptrdiff_t k) __attribute__((always_inline)) { body(node[k], k); };
   for_each_in_chunks<W>(static_cast<std::ptrdiff_t>(region.nodes.size()), listed);
 }
 
-/// Redoes the collide-and-push of the nodes of `region` with Guo forcing, after
-/// stream_collide<false> of the whole block: every slot of next() receives from exactly one
-/// node, so overwriting the pushes of these nodes gives the forced step there and the unforced
-/// one elsewhere. The force must be zero off region.nodes (the nodes between them that its
-/// spans visit take the forced update with zero force: the unforced one up to round-off).
-/// This keeps the forced kernel, about twice the cost per node, to the IB's stencils.
+/// One time step of a block with Guo forcing at the nodes of `region` only (the force must be
+/// zero off region.nodes; the nodes between them that its spans visit take the forced update
+/// with zero force: the unforced one up to round-off), then the parity flip. This keeps the
+/// forced kernel, about twice the cost per node, to the IB's stencils. In place, a node cannot
+/// be updated twice: the region's forced results go to `scratch` (Q values per visited node,
+/// resized when too small) before the unforced sweep of the whole block, and over the sweep's
+/// results at those nodes after it; every slot belongs to one node, so nothing else changes.
 template <class L, class T, class Op>
-void collide_forced_at(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>& force,
-                       const ForcedRegion& region) {
+void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>& force,
+                              const ForcedRegion& region, field::AlignedVector<T>& scratch) {
   constexpr int Q = L::q, D = L::d;
-  const auto& g = pop.grid();
-  const std::ptrdiff_t N = g.size();
-  std::ptrdiff_t off[Q];
-  for (int i = 0; i < Q; ++i) off[i] = g.offset(L::c[i]);
-  const T* src = pop.current();
-  T* dst = pop.next();
+  const std::ptrdiff_t M = region.visited();
+  if (static_cast<std::ptrdiff_t>(scratch.size()) < Q * M) scratch.resize(static_cast<std::size_t>(Q * M));
+  const auto bases = pop.bases();
+  T* P[Q];
+  for (int i = 0; i < Q; ++i) P[i] = bases[i];
   const double* fp[D];
   for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data();
-  // The nodes are distinct, so no two lanes write one slot.
-  auto body = [=](std::ptrdiff_t n) __attribute__((always_inline)) {
-    update_node<true, L, T>(src, dst, N, off, op, fp, n);
+  T* out = scratch.data();
+  // The nodes are distinct, so no two lanes write one slot or one scratch entry.
+  auto forced = [=](std::ptrdiff_t n, std::ptrdiff_t k) __attribute__((always_inline)) {
+    T f[Q], F[D], post[Q];
+#pragma GCC unroll 19
+    for (int i = 0; i < Q; ++i) f[i] = P[i][n];
+    for (int a = 0; a < D; ++a) F[a] = T(fp[a][n]);
+    collide_forced<L, T>(f, F, op, post);
+#pragma GCC unroll 19
+    for (int i = 0; i < Q; ++i) out[i * M + k] = post[i];
   };
-  for_each_forced_node<simd_chunk<T>>(region, body);
+  for_each_forced_node<simd_chunk<T>>(region, forced);
+  sweep<false>(pop, op, nullptr);
+  auto put = [=](std::ptrdiff_t n, std::ptrdiff_t k) __attribute__((always_inline)) {
+#pragma GCC unroll 19
+    for (int i = 0; i < Q; ++i) P[L::opposite[i]][n] = out[i * M + k];
+  };
+  for_each_forced_node<simd_chunk<T>>(region, put);
+  pop.flip_parity();
 }
 
 /// u + F/(2ρ) into `u` at the nodes of `region` (same linear indices; the nodes between them
@@ -274,15 +309,16 @@ template <class L, class T>
 void forced_velocity_at(const field::Populations<L, T>& pop, const field::VectorField<L::d, double>& force,
                         const ForcedRegion& region, field::VectorField<L::d, double>& u) {
   constexpr int Q = L::q, D = L::d;
-  const std::ptrdiff_t N = pop.grid().size();
-  const T* src = pop.current();
+  const auto bases = pop.bases();
+  const T* P[Q];
+  for (int i = 0; i < Q; ++i) P[i] = bases[i];
   const double* fp[D];
   double* up[D];
   for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data(), up[a] = u.comp[a].data();
-  auto body = [=](std::ptrdiff_t n) __attribute__((always_inline)) {
+  auto body = [=](std::ptrdiff_t n, std::ptrdiff_t) __attribute__((always_inline)) {
     double f[Q], rho, v[D];
 #pragma GCC unroll 19
-    for (int i = 0; i < Q; ++i) f[i] = src[i * N + n];
+    for (int i = 0; i < Q; ++i) f[i] = P[i][n];
     moments<L, double>(f, rho, v);
     for (int a = 0; a < D; ++a) up[a][n] = v[a] + fp[a][n] / (2.0 * rho);
   };
@@ -304,7 +340,7 @@ void initialise_equilibrium(field::Populations<L, T>& pop, Init&& init) {
   });
 }
 
-/// ρ and u (with half the force) of node n from the current buffer.
+/// ρ and u (with half the force) of node n at the current time.
 template <class L, class T>
 Moments<L, double> node_moments(const field::Populations<L, T>& pop, std::ptrdiff_t n,
                                 const field::VectorField<L::d, double>* force = nullptr) {

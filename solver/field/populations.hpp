@@ -1,15 +1,30 @@
-// Population storage of one block: structure of arrays, two buffers (A–B pattern).
+// Population storage of one block: structure of arrays, one buffer updated in place (the
+// AA pattern of Bailey et al. 2009, as in the RRZE lbmbench kernels).
 //
 // Stored values are *shifted* populations f_i − w_i (deviation from the rest state ρ = 1,
 // u = 0). Every operation of the method is linear in f or uses only moments, so the shift
 // changes nothing but the round-off: it keeps single-precision storage accurate
 // (the O(1) part of f is not stored). Moments: ρ = 1 + Σ f_i, ρu = Σ c_i f_i.
 //
-// Buffer `current()` holds the pre-collision (post-streaming) populations at time t: the
-// fused kernel reads it, collides, and pushes into `next()`; `swap()` advances time.
-// Population i of node n is at [i · grid.size() + n].
+// Where the pre-collision (post-streaming) population f_i of node n at the current time lies
+// depends on the parity of the step count:
+//   parity 0 ("natural"): slot (i, n), population i's array at node n;
+//   parity 1 ("swapped"): slot (ī, n − c_i), ī the opposite of i: the value node n − c_i
+//                         pushed towards n, still where that node wrote it.
+// Both are base(i) + n with a per-direction base (bases()), so every stage addresses
+// population i of node n as bases[i][n]. A step at parity p reads node n's f_i from
+// bases_p[i][n] and writes its post-collision value i to bases_{1−p}[i][n + c_i]: at parity 0
+// that is (ī, n), at parity 1 (i, n + c_i). Node n reads and writes the same Q slots
+// ({(j, n + c_j)} at parity 1, {(i, n)} at parity 0), no two nodes share a slot, so the update
+// is in place and the order of the nodes does not matter; each step moves 2 Q values per node
+// with no write-allocate (the A–B pattern moved 3 Q). After the step the parity flips, and
+// bases[i][t] of the new parity is also where population i *entering* interior node t from a
+// ghost belongs, and bases[i][g] for a ghost g = s + c_i where interior node s put the
+// population i that *left* it: the boundary and coupling stages fill the first from the second.
+// Only slots reached that way are addressed (base(i) + n stays inside the buffer).
 #pragma once
 
+#include <array>
 #include <span>
 #include <string>
 
@@ -27,35 +42,70 @@ class Populations {
 
   Populations() = default;
   explicit Populations(const Grid<D>& grid) : grid_(grid) {
-    for (auto& b : buf_) b.assign(static_cast<std::size_t>(Q) * grid.size(), T(0));
+    buf_.assign(static_cast<std::size_t>(Q) * grid.size(), T(0));
+    for (int i = 0; i < Q; ++i) off_[i] = grid.offset(L::c[i]);
   }
 
   const Grid<D>& grid() const { return grid_; }
-  T* current() { return buf_[cur_].data(); }
-  const T* current() const { return buf_[cur_].data(); }
-  T* next() { return buf_[1 - cur_].data(); }
-  const T* next() const { return buf_[1 - cur_].data(); }
-  void swap() { cur_ = 1 - cur_; }
+  /// 0 (natural) or 1 (swapped): see the file comment.
+  int parity() const { return parity_; }
+  /// Called by the fused kernel after its in-place sweep (time advances by one step).
+  void flip_parity() { parity_ = 1 - parity_; }
 
-  /// Shifted population i of linear node n in the current buffer.
-  T& operator()(int i, std::ptrdiff_t n) { return buf_[cur_][i * grid_.size() + n]; }
-  T operator()(int i, std::ptrdiff_t n) const { return buf_[cur_][i * grid_.size() + n]; }
+  T* data() { return buf_.data(); }
+  const T* data() const { return buf_.data(); }
 
-  /// Both buffers and which one is current (io/checkpoint.hpp archive).
-  template <class Archive>
-  void checkpoint(Archive& ar, const std::string& prefix) {
-    ar(prefix + "pop_a", std::span<T>(buf_[0]));
-    ar(prefix + "pop_b", std::span<T>(buf_[1]));
-    ar(prefix + "current", cur_);
+  /// Linear offset of the neighbour along c_i.
+  std::ptrdiff_t offset(int i) const { return off_[i]; }
+
+  /// Index into the buffer of grid g's populations of population i of node n at parity p.
+  static std::ptrdiff_t slot(const Grid<D>& g, int p, int i, std::ptrdiff_t n) {
+    return n + (p == 0 ? static_cast<std::ptrdiff_t>(i) * g.size()
+                       : static_cast<std::ptrdiff_t>(L::opposite[i]) * g.size() - g.offset(L::c[i]));
+  }
+  std::ptrdiff_t slot(int i, std::ptrdiff_t n) const { return base_index(parity_, i) + n; }
+
+  /// slot(grid(), p, i, 0).
+  std::ptrdiff_t base_index(int p, int i) const {
+    return p == 0 ? static_cast<std::ptrdiff_t>(i) * grid_.size()
+                  : static_cast<std::ptrdiff_t>(L::opposite[i]) * grid_.size() - off_[i];
   }
 
-  /// Bytes one node update moves in the fused kernel (read Q, write Q values).
+  /// Base pointers of parity p: population i of node n is at bases[i][n].
+  std::array<T*, Q> bases(int p) {
+    std::array<T*, Q> b;
+    for (int i = 0; i < Q; ++i) b[i] = buf_.data() + base_index(p, i);
+    return b;
+  }
+  std::array<const T*, Q> bases(int p) const {
+    std::array<const T*, Q> b;
+    for (int i = 0; i < Q; ++i) b[i] = buf_.data() + base_index(p, i);
+    return b;
+  }
+  std::array<T*, Q> bases() { return bases(parity_); }
+  std::array<const T*, Q> bases() const { return bases(parity_); }
+
+  /// Shifted population i of linear node n at the current time.
+  T& operator()(int i, std::ptrdiff_t n) { return buf_[slot(i, n)]; }
+  T operator()(int i, std::ptrdiff_t n) const { return buf_[slot(i, n)]; }
+
+  /// The buffer and its parity (io/checkpoint.hpp archive). The entry names differ from the
+  /// two-buffer layout of caplab before 2026-12-06, so such a checkpoint is refused by name.
+  template <class Archive>
+  void checkpoint(Archive& ar, const std::string& prefix) {
+    ar(prefix + "populations_in_place", std::span<T>(buf_));
+    ar(prefix + "parity", parity_);
+  }
+
+  /// Bytes one node update moves in the fused kernel: read Q and write Q values, in place
+  /// (no write-allocate: the written lines were just read).
   static constexpr std::size_t bytes_per_update() { return 2 * Q * sizeof(T); }
 
  private:
   Grid<D> grid_;
-  std::array<AlignedVector<T>, 2> buf_;
-  int cur_ = 0;
+  AlignedVector<T> buf_;
+  std::array<std::ptrdiff_t, Q> off_{};
+  int parity_ = 0;
 };
 
 }  // namespace caplab::field

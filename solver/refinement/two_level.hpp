@@ -21,9 +21,10 @@
 // Lagrange formula (eq. 2.14) through t_{n−1}, t_n, t_{n+1}. The ghost node is then collided
 // with the fine operator and pushes into the fine interior, like any ghost of a block.
 //
-// One coarse step: coarse collide-push + boundaries, swap, capture_coarse(); two fine
-// substeps, each: collide-push, fill_fine_ghosts(s) with s = 0 then ½, swap; then
-// restrict_to_coarse(). Exactness: uniform and linear shear flows cross the interface
+// One coarse step: coarse collide-push (in place, parity flip) + boundaries, capture_coarse();
+// two fine substeps, each: collide-push, fill_fine_ghosts(s) with s = 0 then ½; then
+// restrict_to_coarse(). Populations are addressed at each block's current parity
+// (field/populations.hpp). Exactness: uniform and linear shear flows cross the interface
 // unchanged to round-off (tests/verification).
 #pragma once
 
@@ -81,15 +82,15 @@ class TwoLevel {
     }
   }
 
-  /// Fills the fine interior slots entering from the ghost ring (in fine.next()), with the
-  /// coarse state at fractional time s ∈ [0, 1) after the previous coarse level t_n.
+  /// Fills the fine interior slots entering from the ghost ring (after the fine sweep and its
+  /// parity flip), with the coarse state at fractional time s ∈ [0, 1) after the previous
+  /// coarse level t_n.
   template <class Op>
   void fill_fine_ghosts(field::Populations<L, T>& fine, const Op& op_fine, double s) {
     // 3-point Lagrange through t_{n-1} = −1, t_n = 0, t_{n+1} = 1 (eq. 2.14).
     const double lag[3] = {0.5 * s * (s - 1.0), (1.0 - s) * (1.0 + s), 0.5 * s * (s + 1.0)};
     const int lev[3] = {(newest_ + 1) % 3, (newest_ + 2) % 3, newest_};  // t_{n-1}, t_n, t_{n+1}
-    T* next = fine.next();
-    const std::ptrdiff_t N = fine.grid().size();
+    const std::array<T*, Q> P = fine.bases();
     const std::size_t S = sources_.size();
     // In time first, once per source (a source serves up to 16 ghosts), then in space. At
     // s = 0 the formula gives the level t_n itself.
@@ -122,12 +123,12 @@ class TwoLevel {
         }
         for (int i = 0; i < Q; ++i) coarse_f[i][b] = f[i];
       }
-      collide_ghosts(coarse_f, next, N, op_fine, bt * batch);
+      collide_ghosts(coarse_f, P, op_fine, bt * batch);
     }
   }
 
   /// Sets the covered coarse nodes that stream into uncovered ones (the outermost covered
-  /// layer) from the coincident fine nodes, in the current buffer. Deeper covered nodes reach
+  /// layer) from the coincident fine nodes, at the current time. Deeper covered nodes reach
   /// nothing outside the fine block before they are overwritten, so they are left to evolve on
   /// their own; `restrict_everywhere` sets them too, and `fine_node_under` reads through them.
   void restrict_to_coarse(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine) const {
@@ -168,7 +169,7 @@ class TwoLevel {
   /// Ghosts k0 … k0 + batch − 1 from their interpolated coarse populations: rescaled to the
   /// fine block, collided with the fine operator, then pushed along their links.
   template <class Op>
-  void collide_ghosts(const T (&coarse_f)[Q][batch], T* __restrict next, std::ptrdiff_t N, const Op& op,
+  void collide_ghosts(const T (&coarse_f)[Q][batch], const std::array<T*, Q>& P, const Op& op,
                       std::ptrdiff_t k0) const {
     T post[Q][batch];
 #pragma omp simd
@@ -184,7 +185,7 @@ class TwoLevel {
     for (int b = 0; b < batch; ++b) {
       const auto& gh = ghosts_[k0 + b];
       for (int l = gh.first_link; l < gh.first_link + gh.link_count; ++l)
-        next[links_[l].i * N + links_[l].dst] = post[links_[l].i][b];
+        P[links_[l].i][links_[l].dst] = post[links_[l].i][b];
     }
   }
 
@@ -318,9 +319,8 @@ class TwoLevel {
   /// Coarse nodes from their coincident fine nodes, vectorised over batches of nodes.
   void restrict_nodes(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine,
                       const NodePairs& nodes) const {
-    const T* __restrict src = fine.current();
-    T* __restrict dst = coarse.current();
-    const std::ptrdiff_t Nf = fine.grid().size(), Nc = coarse.grid().size();
+    const std::array<const T*, Q> src = fine.bases();
+    const std::array<T*, Q> dst = coarse.bases();
     const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(nodes.coarse.size()) / batch;
 #pragma omp parallel for schedule(static)
     for (std::ptrdiff_t bt = 0; bt < batches; ++bt) {
@@ -331,13 +331,13 @@ class TwoLevel {
         T f[Q], feq[Q];
         // 32-bit node indices into each population's array: a vector gather (as the far field).
 #pragma GCC unroll 19
-        for (int i = 0; i < Q; ++i) f[i] = (src + i * Nf)[nodes.fine[k0 + b]];
+        for (int i = 0; i < Q; ++i) f[i] = src[i][nodes.fine[k0 + b]];
         rescale_non_equilibrium(f, feq, c_from_f_);
 #pragma GCC unroll 19
         for (int i = 0; i < Q; ++i) out[i][b] = f[i];
       }
       for (int b = 0; b < batch; ++b)
-        for (int i = 0; i < Q; ++i) dst[i * Nc + nodes.coarse[k0 + b]] = out[i][b];
+        for (int i = 0; i < Q; ++i) dst[i][nodes.coarse[k0 + b]] = out[i][b];
     }
   }
 

@@ -31,7 +31,7 @@ class Fluid {
   /// body force everywhere except at the nodes the hook changed in its previous call, which
   /// the hook restores first: the IB touches only its stencils, so nothing here sweeps the
   /// whole field every substep. Without a uniform body force only the returned region takes
-  /// the forced kernel (collide_forced_at); with one, the whole block does.
+  /// the forced kernel (stream_collide_forced_at); with one, the whole block does.
   using ForcingHook = std::function<collision::ForcedRegion(const Pop&, Force&)>;
 
   struct Block {
@@ -39,6 +39,7 @@ class Fluid {
     Op op;
     Force force;          // allocated when the block is ever forced
     bool has_body_force = false;
+    field::AlignedVector<T> forced_scratch;  // stream_collide_forced_at's results, grown as needed
   };
 
   struct Setup {
@@ -91,16 +92,19 @@ class Fluid {
   /// One coarse time step (and m = 2 fine substeps). `hook` forces the finest block.
   void step(const ForcingHook& hook = {}) {
     auto& c = blocks_[0];
+    auto coarse_before = [&] { coarse_bc_.prepare(c.pop, c.op); };
+    auto coarse_after = [&] { coarse_bc_.apply(c.pop); };
     if (!two_level()) {
-      advance_block(c, hook, [&] { coarse_bc_.apply(c.pop, c.op); });
+      advance_block(c, hook, coarse_before, coarse_after);
       return;
     }
-    advance_block(c, {}, [&] { coarse_bc_.apply(c.pop, c.op); });
+    advance_block(c, {}, coarse_before, coarse_after);
     core::timed(coupling_seconds_, [&] { coupling_.capture_coarse(c.pop); });
     auto& f = blocks_[1];
     for (int sub = 0; sub < 2; ++sub)
-      advance_block(f, hook,
-                    [&] { core::timed(coupling_seconds_, [&] { coupling_.fill_fine_ghosts(f.pop, f.op, 0.5 * sub); }); });
+      advance_block(f, hook, [] {}, [&] {
+        core::timed(coupling_seconds_, [&] { coupling_.fill_fine_ghosts(f.pop, f.op, 0.5 * sub); });
+      });
     core::timed(coupling_seconds_, [&] { coupling_.restrict_to_coarse(c.pop, f.pop); });
   }
 
@@ -137,10 +141,12 @@ class Fluid {
   }
 
  private:
-  static Block make_block(const field::Grid<D>& g, const Op& op) { return Block{Pop(g), op, Force(0), false}; }
+  static Block make_block(const field::Grid<D>& g, const Op& op) { return Block{Pop(g), op, Force(0), false, {}}; }
 
-  template <class Boundaries>
-  void advance_block(Block& blk, const ForcingHook& hook, Boundaries&& apply_boundaries) {
+  /// One step of a block: forcing hook, then the boundaries' stage before the in-place sweep
+  /// (what reads the state at time t), the sweep, and the stage that fills the entering slots.
+  template <class Before, class After>
+  void advance_block(Block& blk, const ForcingHook& hook, Before&& before_sweep, After&& apply_boundaries) {
     const std::size_t b = &blk - blocks_.data();
     collision::ForcedRegion forced;
     if (hook) {
@@ -150,14 +156,14 @@ class Fluid {
       }
       forced = hook(blk.pop, blk.force);
     }
-    if (blk.has_body_force) {
+    before_sweep();
+    if (blk.has_body_force)
       collision::stream_collide<true>(blk.pop, blk.op, &blk.force);
-    } else {
+    else if (!forced.empty())
+      collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced, blk.forced_scratch);
+    else
       collision::stream_collide<false>(blk.pop, blk.op);
-      if (!forced.empty()) collision::collide_forced_at(blk.pop, blk.op, blk.force, forced);
-    }
     apply_boundaries();
-    blk.pop.swap();
   }
 
   std::vector<Block> blocks_;

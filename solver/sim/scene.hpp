@@ -1036,8 +1036,8 @@ class Scene {
   std::vector<collision::NodeSpan> forced_spans_;
   ibm::StencilUnion stencil_union_;
   // u* + f / (2 rho) at forced_nodes_ (stale elsewhere): D doubles per node of the finest
-  // block, for interpolation by rows (24 bytes per 3D node, against 152 for the two buffers of
-  // float populations)
+  // block, for interpolation by rows (24 bytes per 3D node, against 76 for the float
+  // populations)
   field::VectorField<D> forced_velocity_;
   std::vector<CapsuleTrack<D>> capsule_tracks_;
   std::array<bool, D> periodic_{};

@@ -165,7 +165,7 @@ double estimate_memory_bytes(const CaseSpec& spec, const std::vector<BlockUnits>
     double n = 1;
     for (int k : blocks[b].nodes) n *= k + 2.0;
     largest = std::max(largest, n);
-    bytes += n * 2 * q * value;  // populations, two buffers (A-B pattern)
+    bytes += n * q * value;  // populations, one buffer (in place, field/populations.hpp)
     const bool finest = b + 1 == blocks.size();
     if (body_force || (finest && bodies)) bytes += n * D * 8.0;  // force density (double)
     if (finest && bodies) bytes += n * 8.0;                      // forced-node slot and stamp (int32 each)

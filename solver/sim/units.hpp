@@ -60,7 +60,7 @@ LatticeUnits derive_units(const cases::CaseSpec& spec);
 std::string tau_near_half_cause(const cases::CollisionSpec& collision, double tau);
 
 /// Bytes a run of `spec` on `blocks` allocates for what scales with the lattice: populations
-/// (two buffers, Q values of the case's precision per node), the force density of the finest
+/// (one buffer updated in place, Q values of the case's precision per node), the force density of the finest
 /// block when it carries bodies (of every block with a body-force flow), the forced-node
 /// bookkeeping, and the fields of one block while a snapshot is written.
 double estimate_memory_bytes(const cases::CaseSpec& spec, const std::vector<BlockUnits>& blocks);
