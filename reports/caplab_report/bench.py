@@ -12,7 +12,8 @@ Inputs:
 Output: ``OUT/index.html`` (+ ``index.pdf`` printed by headless Chromium), self-contained.
 
 Definitions used on the page:
-  roofline_mlups   copy bandwidth / bytes per update (bench.json "roofline"); fraction = MLUPS / roofline;
+  roofline_mlups   in-place update bandwidth / bytes per update (bench.json "roofline"); fraction = MLUPS /
+                   roofline; roofline_mlups_copy the same with the copy bandwidth;
   two-level overhead   uniform MLUPS / two-level MLUPS - 1 at the same lattice, collision, precision and
                    threads (bench.json "overhead_vs_uniform"), the uniform box of the same coarse size
                    timed in batches alternating with the two-level ones ("uniform_twin_mlups"), the
@@ -76,7 +77,7 @@ def _read(path: Path):
 # ---- bench.json: bandwidth, roofline, MLUPS ------------------------------------------------------
 
 def bandwidth_rows(bench: dict) -> list[dict]:
-    """Best copy/triad bandwidth per thread count, with the before/after runs beside it."""
+    """Best copy/triad/update bandwidth per thread count, with the before/after update runs beside it."""
     bw = bench.get("bandwidth") or {}
     runs = bw.get("runs") or []
     rows = []
@@ -84,10 +85,12 @@ def bandwidth_rows(bench: dict) -> list[dict]:
         t = b.get("threads")
         mine = [r for r in runs if r.get("threads") == t]
         rows.append({"threads": t, "copy_gbs": b.get("copy_gbs"), "triad_gbs": b.get("triad_gbs"),
+                     "update_gbs": b.get("update_gbs"),
                      "copy_median": b.get("copy_gbs_median"), "triad_median": b.get("triad_gbs_median"),
+                     "update_median": b.get("update_gbs_median"),
                      "validated": b.get("validated"),
-                     "runs": ", ".join(f"{r.get('when', '?')} {r.get('copy_gbs', float('nan')):.1f}" for r in mine
-                                       if _num(r.get("copy_gbs")))})
+                     "runs": ", ".join(f"{r.get('when', '?')} {r.get('update_gbs', float('nan')):.1f}" for r in mine
+                                       if _num(r.get("update_gbs")))})
     return rows
 
 
@@ -104,13 +107,13 @@ def fluid_rows(bench: dict, kind: str = "uniform") -> list[dict]:
 
 
 def bytes_per_update(bench: dict) -> list[dict]:
-    """One row per lattice and precision: bytes moved per node update (2 Q sizeof T, and with the
-    write-allocate 3 Q sizeof T) and the roofline MLUPS per thread count."""
+    """One row per lattice and precision: bytes moved per node update (2 Q sizeof T, in place) and the
+    roofline MLUPS per thread count."""
     out: dict[tuple, dict] = {}
     for r in fluid_rows(bench):
         key = (r.get("lattice"), r.get("precision"))
         row = out.setdefault(key, {"lattice": key[0], "precision": key[1], "bytes": r.get("bytes_per_update"),
-                                   "bytes_wa": r.get("bytes_per_update_write_allocate"), "roofline": {}})
+                                   "roofline": {}})
         row["roofline"][r.get("threads")] = r.get("roofline_mlups")
     return list(out.values())
 
@@ -143,7 +146,7 @@ def roofline_figure(bench: dict) -> str | None:
     ax.set_yscale("log")
     ax.set_xlim(lo, hi)
     ax.set_ylim(lo, hi)
-    ax.set_xlabel("roofline [MLUPS] = copy bandwidth / bytes per update")
+    ax.set_xlabel("roofline [MLUPS] = in-place update bandwidth / bytes per update")
     ax.set_ylabel("measured [MLUPS]")
     ax.grid(True, which="both", lw=0.3, alpha=0.6)
     ax.legend(fontsize=7, loc="upper left")

@@ -8,10 +8,10 @@
 //     thread count (first selected collision and precision) with its overhead against the
 //     uniform box of the same configuration.
 //  3. Roofline per row: bytes per node update B_u = Populations::bytes_per_update() = 2 Q
-//     sizeof(T) (read Q, write Q), roofline MLUPS = copy bandwidth / B_u, fraction = MLUPS /
-//     roofline. Copy has the kernel's 1:1 read:write ratio and both count bytes without the
-//     write-allocate, so the two are consistent; the row also gives B_u with write-allocate
-//     (3 Q sizeof(T)) and bandwidth / that (a bound that is only reached with streaming stores).
+//     sizeof(T) (the in-place kernel reads a node's Q values and writes them back), roofline
+//     MLUPS = in-place update bandwidth / B_u, fraction = MLUPS / roofline. The update kernel
+//     b = s·b has the fluid kernel's access pattern (read a line, write it back, no
+//     write-allocate), so the two are consistent; the row also gives copy bandwidth / B_u.
 // Timings are noisy on a shared machine: nothing here is a pass/fail threshold.
 #pragma once
 

@@ -164,7 +164,6 @@ FluidMeasurement measure(const FluidCase& c, double min_seconds) {
     r.overhead = ratios[ratios.size() / 2] - 1.0;
   }
   r.bytes_per_update = field::Populations<L, T>::bytes_per_update();
-  r.bytes_per_update_write_allocate = 3 * L::q * sizeof(T);
 
   check_flow(*fluid);
   if (twin) check_flow(*twin);

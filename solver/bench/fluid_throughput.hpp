@@ -48,7 +48,6 @@ struct FluidMeasurement {
   /// were descheduled (other work on the machine) and the timing is contended.
   double cpu_share = 0;
   std::size_t bytes_per_update = 0;                 // Populations::bytes_per_update()
-  std::size_t bytes_per_update_write_allocate = 0;  // 3 Q sizeof(T)
 };
 
 /// Supported names, for validation and messages.

@@ -41,8 +41,9 @@ StreamResult measure_stream_bandwidth(int threads, std::size_t array_bytes, int 
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (long i = 0; i < n; ++i) a[i] = 1.0, b[i] = 2.0, c[i] = 0.0;
 
-  std::vector<double> t_copy, t_triad;
-  double expected_a = 1.0;
+  std::vector<double> t_copy, t_triad, t_update;
+  double expected_a = 1.0, expected_b = 2.0;
+  const double s_update = 1.0000001;  // b stays near 2 over any repetition count
   for (int r = 0; r <= repetitions; ++r) {
     double t0 = now_seconds();
 #pragma omp parallel for schedule(static) num_threads(threads)
@@ -51,29 +52,37 @@ StreamResult measure_stream_bandwidth(int threads, std::size_t array_bytes, int 
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (long i = 0; i < n; ++i) a[i] = b[i] + s * c[i];
     double t2 = now_seconds();
-    expected_a = 2.0 + s * expected_a;
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long i = 0; i < n; ++i) b[i] = s_update * b[i];
+    double t3 = now_seconds();
+    // The triad read b before this repetition's update scaled it.
+    expected_a = expected_b + s * expected_a;
+    expected_b *= s_update;
     if (r == 0) continue;  // warm-up: page faults, frequency ramp
     t_copy.push_back(t1 - t0);
     t_triad.push_back(t2 - t1);
+    t_update.push_back(t3 - t2);
   }
 
   bool ok = true;
   for (long i : {0L, n / 3, n / 2, n - 1})
-    ok = ok && std::abs(a[i] - expected_a) <= 1e-12 * expected_a && b[i] == 2.0;
+    ok = ok && std::abs(a[i] - expected_a) <= 1e-12 * expected_a && std::abs(b[i] - expected_b) <= 1e-12 * expected_b;
   alloc.deallocate(a, n);
   alloc.deallocate(b, n);
   alloc.deallocate(c, n);
   CAPLAB_CHECK(ok, "bench: stream kernels produced wrong values");
 
-  const double copy_bytes = 2.0 * sizeof(double) * n, triad_bytes = 3.0 * sizeof(double) * n;
+  const double copy_bytes = 2.0 * sizeof(double) * n, triad_bytes = 3.0 * sizeof(double) * n;  // update: as copy
   StreamResult r;
   r.threads = threads;
   r.array_bytes = static_cast<std::size_t>(n) * sizeof(double);
   r.repetitions = repetitions;
   r.copy_gbs = copy_bytes / *std::min_element(t_copy.begin(), t_copy.end()) * 1e-9;
   r.triad_gbs = triad_bytes / *std::min_element(t_triad.begin(), t_triad.end()) * 1e-9;
+  r.update_gbs = copy_bytes / *std::min_element(t_update.begin(), t_update.end()) * 1e-9;
   r.copy_gbs_median = copy_bytes / median(t_copy) * 1e-9;
   r.triad_gbs_median = triad_bytes / median(t_triad) * 1e-9;
+  r.update_gbs_median = copy_bytes / median(t_update) * 1e-9;
   r.validated = ok;
   return r;
 }

@@ -136,8 +136,7 @@ def bench_json() -> dict:
         r = {"kind": kind, "lattice": lat, "collision": col, "precision": prec, "threads": t,
              "size": [64] * (2 if lat == "D2Q9" else 3), "updates_per_step": 4096, "steps": 100, "seconds": 1.0,
              "mlups": mlups, "mlups_best_batch": mlups * 1.05, "cpu_share": 0.97, "bytes_per_update": q * size // 8 * 8,
-             "bytes_per_update_write_allocate": q * size // 8 * 12, "bandwidth_gbs": 20.0, "roofline_mlups": roof,
-             "roofline_mlups_write_allocate": roof * 2 / 3, "fraction": mlups / roof}
+             "bandwidth_gbs": 20.0, "roofline_mlups": roof, "roofline_mlups_copy": roof * 0.8, "fraction": mlups / roof}
         r.update(extra)
         return r
 
@@ -145,9 +144,10 @@ def bench_json() -> dict:
             "options": {"threads": [1, 2], "quick": False, "stream_repetitions": 10, "stream_array_mib": 64},
             "warnings": ["a test warning from caplab bench"],
             "bandwidth": {"convention": "STREAM counting", "runs": [
-                {"threads": 1, "when": "before", "copy_gbs": 10.0}, {"threads": 1, "when": "after", "copy_gbs": 11.0}],
-                "per_threads": [{"threads": 1, "copy_gbs": 11.0, "triad_gbs": 10.5, "validated": True},
-                                {"threads": 2, "copy_gbs": 20.0, "triad_gbs": 19.0, "validated": True}]},
+                {"threads": 1, "when": "before", "copy_gbs": 10.0, "update_gbs": 12.5},
+                {"threads": 1, "when": "after", "copy_gbs": 11.0, "update_gbs": 13.75}],
+                "per_threads": [{"threads": 1, "copy_gbs": 11.0, "triad_gbs": 10.5, "update_gbs": 13.75, "validated": True},
+                                {"threads": 2, "copy_gbs": 20.0, "triad_gbs": 19.0, "update_gbs": 25.0, "validated": True}]},
             "roofline": "roofline_mlups = copy GB/s / bytes_per_update", "mlups_definition": "steps x updates / s",
             "rows": [row("uniform", "D2Q9", "trt", "double", 1, 61.1, 76.4),
                      row("uniform", "D3Q19", "trt", "float", 2, 98.7, 131.6),
