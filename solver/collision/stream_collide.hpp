@@ -71,11 +71,10 @@ template <int Q, class T>
 /// Collide-and-push of node n in place (the body of the fused kernel's vector loop): reads
 /// f_i from P[i][n], writes the post-collision value i to P[ī][n] (field/populations.hpp: the
 /// same Q slots, and where the next step at the other parity finds it at node n + c_i).
-/// `store` false leaves the slots untouched (a lane of a chunk that was already updated).
 /// Scalars and references to C arrays only, so that GCC vectorizes the loop that calls it.
 template <bool Forced, class L, class T, class Op>
 [[gnu::always_inline]] inline void update_node(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
-                                               std::ptrdiff_t n, bool store = true) {
+                                               std::ptrdiff_t n) {
   constexpr int Q = L::q, D = L::d;
   T f[Q], feq[Q], out[Q], rho, u[D];
 #pragma GCC unroll 19
@@ -89,9 +88,24 @@ template <bool Forced, class L, class T, class Op>
     equilibrium<L, T>(rho, u, feq);
     op.template collide<L, T>(f, feq, out);
   }
-  if (store) {
 #pragma GCC unroll 19
-    for (int i = 0; i < Q; ++i) P[L::opposite[i]][n] = out[i];
+  for (int i = 0; i < Q; ++i) P[L::opposite[i]][n] = out[i];
+}
+
+/// Updates the `rem` (< 2w) nodes from `at` as pieces of w, w/2, …, 1 consecutive nodes, each a
+/// vector loop of a trip count known at compile time: the end of a row without overlapping
+/// chunks. Out of line and flattened: inlined into the row loop, GCC 12 ran out of inlining
+/// budget, called the collision out of line and left the pieces scalar.
+template <int w, bool Forced, class L, class T, class Op>
+[[gnu::noinline, gnu::flatten]] void update_pieces(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
+                                                 std::ptrdiff_t at, int rem) {
+  if constexpr (w >= 1) {
+    if (rem & w) {
+#pragma omp simd
+      for (int x = 0; x < w; ++x) update_node<Forced, L, T>(P, op, fp, at + x);
+      at += w;
+    }
+    update_pieces<w / 2, Forced, L, T>(P, op, fp, at, rem);
   }
 }
 
@@ -99,11 +113,14 @@ template <bool Forced, class L, class T, class Op>
 /// (stream_collide and stream_collide_forced_at flip it).
 ///
 /// Each row runs in chunks of simd_chunk<T> nodes with a trip count known at compile time, so
-/// the whole row is vector code; the last chunk is shifted back to end at the row's end and
-/// does not store the lanes that the chunk before already updated (masked stores: in place, a
-/// node updated twice would collide its own output). (A row of 47 nodes, the fine block of a
-/// chapter 5 sphere, otherwise ends in a 15-node scalar remainder: measured 51 MLUPS at 47^3
-/// against 128 at 48^3, D3Q19 TRT single, 2 threads.)
+/// the whole row is vector code, and the rest of the row in pieces of half, a quarter … of a
+/// chunk (update_pieces). (A row of 47 nodes, the fine block of a chapter 5 sphere, otherwise
+/// ends in a 15-node scalar remainder: measured 51 MLUPS at 47^3 against 128 at 48^3, D3Q19 TRT
+/// single, 2 threads, A–B pattern.) The A–B kernel instead redid a few nodes in a last chunk
+/// shifted back to end at the row's end; in place a node must not be updated twice, and the
+/// shifted chunk with the overlapping lanes blended back was slow: its loads partly overlap the
+/// stores of the chunk before (measured 47^3 D3Q19 BGK, 2 threads: double 136, float 106 MLUPS
+/// against 208 / 353 at 48^3; with the shifted chunk first, 87 / 59).
 template <bool Forced, class L, class T, class Op>
 void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>* force) {
   constexpr int Q = L::q, D = L::d, W = simd_chunk<T>;
@@ -121,11 +138,6 @@ void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField
     const Op op_l = op;
     const double* fp_l[D];
     for (int a = 0; a < D; ++a) fp_l[a] = fp[a];
-    if (nx < W) {
-#pragma omp simd
-      for (int x = 0; x < nx; ++x) update_node<Forced, L, T>(P_l, op_l, fp_l, base + x);
-      return;
-    }
     const int whole = nx - nx % W;
     for (int x0 = 0; x0 < whole; x0 += W) {
       const std::ptrdiff_t chunk = base + x0;
@@ -135,12 +147,7 @@ void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField
 #pragma omp simd
       for (int x = 0; x < W; ++x) update_node<Forced, L, T>(P_l, op_l, fp_l, chunk + x);
     }
-    if (whole < nx) {
-      const std::ptrdiff_t chunk = base + nx - W;
-      const int done = whole - (nx - W);  // lanes the last whole chunk updated
-#pragma omp simd
-      for (int x = 0; x < W; ++x) update_node<Forced, L, T>(P_l, op_l, fp_l, chunk + x, x >= done);
-    }
+    update_pieces<W / 2, Forced, L, T>(P_l, op_l, fp_l, base + whole, nx - whole);
   });
 }
 

@@ -1,4 +1,4 @@
-// Lattice units of a case: the memory estimate (populations in two buffers, force density,
+// Lattice units of a case: the memory estimate (populations in one buffer, force density,
 // forced-node bookkeeping, snapshot scratch), the refusal of cases that do not fit in the
 // machine's memory, and the refusal of runs whose step count no integer holds.
 #include <gtest/gtest.h>
