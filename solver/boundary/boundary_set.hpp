@@ -177,9 +177,10 @@ class BoundarySet {
     }
   }
 
-  /// Entering population i of interior node t ← population j of node g (as the A–B pattern
-  /// addressed them in the buffer after the push: the slot where it left, g a ghost or, for a
-  /// wall, g = t − c_i with j = ī) + add, for both parities after the sweep.
+  /// Entering population i of interior node t ← population j at node `src` + add, for both
+  /// parities after the sweep. Population j at src is where a population left: for periodic
+  /// ghosts src is the ghost it left into (j = i), for walls src = t − c_i and j = ī (what t
+  /// sent towards the wall).
   void add_copy(const field::Grid<D>& g, int i, std::ptrdiff_t t, int j, std::ptrdiff_t src, double add) {
     using Pop = field::Populations<L, T>;
     for (int p = 0; p < 2; ++p) copies_[p].push_back({Pop::slot(g, p, i, t), Pop::slot(g, p, j, src), add});

@@ -193,6 +193,8 @@ template <int W, class Body>
 /// first + j), for per-node scratch such as the forced collision's results.
 struct NodeSpan {
   std::ptrdiff_t begin, end, first = 0;
+  /// The number of the node after the span's last (the next span's `first`).
+  std::ptrdiff_t past_last() const { return first + end - begin; }
 };
 
 /// The nodes a forcing stage visits: distinct interior nodes in memory order and, where the
@@ -203,7 +205,7 @@ struct ForcedRegion {
   bool empty() const { return nodes.empty(); }
   /// Nodes the walkers visit: the spans' nodes, or the listed ones (the dense numbering).
   std::ptrdiff_t visited() const {
-    return spans.empty() ? static_cast<std::ptrdiff_t>(nodes.size()) : spans.back().first + spans.back().end - spans.back().begin;
+    return spans.empty() ? static_cast<std::ptrdiff_t>(nodes.size()) : spans.back().past_last();
   }
 };
 
@@ -214,7 +216,8 @@ struct ForcedRegion {
 /// Nodes of one row less than 2W apart share a span (the nodes between are visited too); a
 /// span shorter than W grows to W inside its row, backwards at the row's end. Spans are
 /// disjoint: two spans of one row are at least 2W − 1 apart before growing and each grows by
-/// less than W; their nodes are numbered densely in order (NodeSpan::first). Leaves `spans` empty when the rows are shorter than W. W is the walker's chunk
+/// less than W; their nodes are numbered densely in order (NodeSpan::first). Leaves `spans`
+/// empty when the rows are shorter than W. W is the walker's chunk
 /// (for_each_in_spans<W>, a span shorter than it would be overrun): both take it at compile
 /// time, simd_chunk<T> of the populations.
 template <int W, int D>
@@ -232,8 +235,7 @@ void cover_with_spans(const field::Grid<D>& g, std::span<const std::ptrdiff_t> n
       begin = std::min(begin, row_hi - W);
       end = begin + W;
     }
-    const std::ptrdiff_t first = spans.empty() ? 0 : spans.back().first + spans.back().end - spans.back().begin;
-    spans.push_back({begin, end, first});
+    spans.push_back({begin, end, spans.empty() ? 0 : spans.back().past_last()});
   }
 }
 
@@ -278,8 +280,9 @@ template <int W, class Body>
 /// resized when too small) before the unforced sweep of the whole block, and over the sweep's
 /// results at those nodes after it; every slot belongs to one node, so nothing else changes.
 template <class L, class T, class Op>
-void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>& force,
-                              const ForcedRegion& region, field::AlignedVector<T>& scratch) {
+void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op,
+                              const field::VectorField<L::d, double>& force, const ForcedRegion& region,
+                              field::AlignedVector<T>& scratch) {
   constexpr int Q = L::q, D = L::d;
   const std::ptrdiff_t M = region.visited();
   if (static_cast<std::ptrdiff_t>(scratch.size()) < Q * M) scratch.resize(static_cast<std::size_t>(Q * M));

@@ -55,31 +55,21 @@ class Populations {
   T* data() { return buf_.data(); }
   const T* data() const { return buf_.data(); }
 
-  /// Linear offset of the neighbour along c_i.
-  std::ptrdiff_t offset(int i) const { return off_[i]; }
-
   /// Index into the buffer of grid g's populations of population i of node n at parity p.
   static std::ptrdiff_t slot(const Grid<D>& g, int p, int i, std::ptrdiff_t n) {
-    return n + (p == 0 ? static_cast<std::ptrdiff_t>(i) * g.size()
-                       : static_cast<std::ptrdiff_t>(L::opposite[i]) * g.size() - g.offset(L::c[i]));
+    return base(g.size(), p, i, g.offset(L::c[i])) + n;
   }
-  std::ptrdiff_t slot(int i, std::ptrdiff_t n) const { return base_index(parity_, i) + n; }
-
-  /// slot(grid(), p, i, 0).
-  std::ptrdiff_t base_index(int p, int i) const {
-    return p == 0 ? static_cast<std::ptrdiff_t>(i) * grid_.size()
-                  : static_cast<std::ptrdiff_t>(L::opposite[i]) * grid_.size() - off_[i];
-  }
+  std::ptrdiff_t slot(int i, std::ptrdiff_t n) const { return base(grid_.size(), parity_, i, off_[i]) + n; }
 
   /// Base pointers of parity p: population i of node n is at bases[i][n].
   std::array<T*, Q> bases(int p) {
     std::array<T*, Q> b;
-    for (int i = 0; i < Q; ++i) b[i] = buf_.data() + base_index(p, i);
+    for (int i = 0; i < Q; ++i) b[i] = buf_.data() + base(grid_.size(), p, i, off_[i]);
     return b;
   }
   std::array<const T*, Q> bases(int p) const {
     std::array<const T*, Q> b;
-    for (int i = 0; i < Q; ++i) b[i] = buf_.data() + base_index(p, i);
+    for (int i = 0; i < Q; ++i) b[i] = buf_.data() + base(grid_.size(), p, i, off_[i]);
     return b;
   }
   std::array<T*, Q> bases() { return bases(parity_); }
@@ -102,9 +92,15 @@ class Populations {
   static constexpr std::size_t bytes_per_update() { return 2 * Q * sizeof(T); }
 
  private:
+  /// Where population i's values of parity p start, N nodes per population, off_i the linear
+  /// offset of c_i: node n's value is at base + n.
+  static std::ptrdiff_t base(std::ptrdiff_t N, int p, int i, std::ptrdiff_t off_i) {
+    return p == 0 ? i * N : L::opposite[i] * N - off_i;
+  }
+
   Grid<D> grid_;
   AlignedVector<T> buf_;
-  std::array<std::ptrdiff_t, Q> off_{};
+  std::array<std::ptrdiff_t, Q> off_{};  // linear offsets of the lattice directions
   int parity_ = 0;
 };
 

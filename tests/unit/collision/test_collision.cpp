@@ -438,7 +438,7 @@ TEST(CoverWithSpans, SpansAreDisjointRowStretchesOfWholeChunksThatCoverEveryNode
     if (k > 0) {
       EXPECT_GE(spans[k].begin, spans[k - 1].end);
       // Dense numbering of the visited nodes, in order.
-      EXPECT_EQ(spans[k].first, spans[k - 1].first + spans[k - 1].end - spans[k - 1].begin) << "span " << k;
+      EXPECT_EQ(spans[k].first, spans[k - 1].first + (spans[k - 1].end - spans[k - 1].begin)) << "span " << k;
     }
   }
   EXPECT_EQ(spans[0].first, 0);
