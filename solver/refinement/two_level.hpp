@@ -21,6 +21,14 @@
 // Lagrange formula (eq. 2.14) through t_{n−1}, t_n, t_{n+1}. The ghost node is then collided
 // with the fine operator and pushes into the fine interior, like any ghost of a block.
 //
+// Evaluation. The ghost ring is cut into disjoint faces (a face: the ghosts at fine index −1 or
+// n along its normal axis; the in-face axes before the normal over the interior range, those
+// after it over the ring too, so edges and corners belong to exactly one face). The stencils
+// are tensor products, so a face is interpolated axis by axis on whole rows of one population
+// (structure of arrays, vector loops): the coarse plane under the face in time, then along the
+// first in-face axis u onto the fine spacing, then along the second, v (3D), row by row just
+// before the row's ghosts are collided. The history keeps the coarse planes, not whole nodes.
+//
 // One coarse step: coarse collide-push (in place, parity flip) + boundaries, capture_coarse();
 // two fine substeps, each: collide-push, fill_fine_ghosts(s) with s = 0 then ½; then
 // restrict_to_coarse(). Populations are addressed at each block's current parity
@@ -28,10 +36,13 @@
 // unchanged to round-off (tests/verification).
 #pragma once
 
+#include <omp.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
-#include <map>
+#include <utility>
 #include <vector>
 
 #include "collision/equilibrium.hpp"
@@ -60,14 +71,9 @@ class TwoLevel {
         f_from_c_{tau_f.plus / (m * tau_c.plus), tau_f.minus / (m * tau_c.minus)} {
     CAPLAB_CHECK(std::abs(coarse.dx() - m * fine.dx()) < 1e-12 * coarse.dx(),
                  "two-level coupling needs coarse spacing = 2 × fine spacing");
-    build_ghost_stencils();
     build_restriction();
-    history_.assign(3 * sources_.size() * Q, T(0));
-    at_s_.assign(sources_.size() * Q, T(0));
-    // Whole batches: the last one is filled with ghosts that have no weight (f = 0, the rest
-    // state) and no link.
-    while (ghosts_.size() % batch != 0)
-      ghosts_.push_back({static_cast<int>(weights_.size()), 0, static_cast<int>(links_.size()), 0});
+    build_faces();
+    history_.assign(3 * Q * sources_.size(), T(0));
   }
 
   /// Records the coarse populations needed by the fine ghosts at the new coarse time level.
@@ -88,42 +94,55 @@ class TwoLevel {
   template <class Op>
   void fill_fine_ghosts(field::Populations<L, T>& fine, const Op& op_fine, double s) {
     // 3-point Lagrange through t_{n-1} = −1, t_n = 0, t_{n+1} = 1 (eq. 2.14).
-    const double lag[3] = {0.5 * s * (s - 1.0), (1.0 - s) * (1.0 + s), 0.5 * s * (s + 1.0)};
-    const int lev[3] = {(newest_ + 1) % 3, (newest_ + 2) % 3, newest_};  // t_{n-1}, t_n, t_{n+1}
-    const std::array<T*, Q> P = fine.bases();
+    const T lag[3] = {T(0.5 * s * (s - 1.0)), T((1.0 - s) * (1.0 + s)), T(0.5 * s * (s + 1.0))};
     const std::size_t S = sources_.size();
-    // In time first, once per source (a source serves up to 16 ghosts), then in space. At
-    // s = 0 the formula gives the level t_n itself.
-    const T* at_s = &history_[lev[1] * S * Q];
-    if (s != 0.0) {
-      T* out = at_s_.data();
-#pragma omp parallel for schedule(static)
-      for (std::size_t src = 0; src < S; ++src) {
-        const T* h0 = &history_[(lev[0] * S + src) * Q];
-        const T* h1 = &history_[(lev[1] * S + src) * Q];
-        const T* h2 = &history_[(lev[2] * S + src) * Q];
-        for (int i = 0; i < Q; ++i) out[src * Q + i] = T(lag[0]) * h0[i] + T(lag[1]) * h1[i] + T(lag[2]) * h2[i];
-      }
-      at_s = out;
-    }
-    // Then, per batch of ghosts, in space (into a small structure of arrays) and the collision
-    // vectorised over the batch (as the far field, boundary/boundary_set.hpp).
-    const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(ghosts_.size()) / batch;
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t bt = 0; bt < batches; ++bt) {
-      T coarse_f[Q][batch];
-      for (int b = 0; b < batch; ++b) {
-        const auto& gh = ghosts_[bt * batch + b];
-        T f[Q] = {};
-        for (int w = gh.first_weight; w < gh.first_weight + gh.weight_count; ++w) {
-          const auto& sw = weights_[w];
-          const T* h = &at_s[sw.source * Q];
-          const T c = T(sw.weight);
-          for (int i = 0; i < Q; ++i) f[i] += c * h[i];
+    const T* h[3] = {&history_[(newest_ + 1) % 3 * Q * S], &history_[(newest_ + 2) % 3 * Q * S],
+                     &history_[newest_ * Q * S]};  // t_{n-1}, t_n, t_{n+1}
+    const std::array<T*, Q> P = fine.bases();
+    // Scratch per thread, sized once (and again only if more threads run than before).
+    const std::size_t threads = static_cast<std::size_t>(omp_get_max_threads());
+    if (scratch_.size() < threads) scratch_.resize(threads, std::vector<T>(max_coarse_u_ + scratch_size_));
+    const std::ptrdiff_t tasks = static_cast<std::ptrdiff_t>(chunks_.size());
+#pragma omp parallel for schedule(dynamic)
+    for (std::ptrdiff_t task = 0; task < tasks; ++task) {
+      const Chunk& ch = chunks_[task];
+      const Face& fc = faces_[ch.face];
+      const int cu_n = fc.axis[0].coarse, row = fc.row;
+      T* in_time = scratch_[omp_get_thread_num()].data();  // one coarse row (s > 0)
+      T* along_u = in_time + max_coarse_u_;                // [i][coarse v − cv0][row]
+      // The chunk's coarse rows: in time (at s = 0 the formula gives the level t_n), along u.
+      for (int i = 0; i < Q; ++i)
+        for (int cv = ch.cv0; cv < ch.cv1; ++cv) {
+          const std::size_t at = i * S + fc.first_source + static_cast<std::size_t>(cv) * cu_n;
+          const T* coarse_row = h[1] + at;
+          if (s != 0.0) {
+#pragma omp simd
+            for (int cu = 0; cu < cu_n; ++cu) in_time[cu] = lag[0] * h[0][at + cu] + lag[1] * h[1][at + cu] + lag[2] * h[2][at + cu];
+            coarse_row = in_time;
+          }
+          fc.axis[0].interpolate(coarse_row, along_u + (i * (ch.cv1 - ch.cv0) + cv - ch.cv0) * row);
         }
-        for (int i = 0; i < Q; ++i) coarse_f[i][b] = f[i];
+      // Its ghost rows along v, a batch at a time, then their collision and push.
+      for (int fv = ch.fv0; fv < ch.fv1; ++fv) {
+        const auto [first, count] = fc.axis[1].stencil(fv);
+        const T* u_rows = along_u + (first - ch.cv0) * row;
+        const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(ch.cv1 - ch.cv0) * row;  // between populations
+        for (int b0 = 0; b0 < row; b0 += batch) {
+          T coarse_f[Q][batch];
+          for (int i = 0; i < Q; ++i) {
+            const T* r0 = u_rows + i * stride + b0;
+            if (count == 1) {
+#pragma omp simd
+              for (int b = 0; b < batch; ++b) coarse_f[i][b] = r0[b];
+            } else {
+#pragma omp simd
+              for (int b = 0; b < batch; ++b)
+                coarse_f[i][b] = midpoint(r0[b], r0[row + b], r0[2 * row + b], r0[3 * row + b]);
+            }
+          }
+          collide_ghosts(coarse_f, P, op_fine, fc.first_ghost + static_cast<std::ptrdiff_t>(fv) * row + b0);
+        }
       }
-      collide_ghosts(coarse_f, P, op_fine, bt * batch);
     }
   }
 
@@ -189,12 +208,47 @@ class TwoLevel {
     }
   }
 
-  struct Weight {
-    std::size_t source;  // index into sources_
-    double weight;
-  };
   struct Ghost {
-    int first_weight, weight_count, first_link, link_count;
+    int first_link, link_count;
+  };
+  /// The cubic midpoint value (−1, 9, 9, −1)/16 of four consecutive coarse values.
+  static T midpoint(T a, T b, T c, T d) { return T(9.0 / 16) * (b + c) - T(1.0 / 16) * (a + d); }
+
+  /// One in-face axis of a face: its fine ghost coordinates (from `fine_lo`, `fine` of them) and
+  /// the coarse nodes under them (from `coarse_lo`, `coarse` of them). The fine coordinate j
+  /// lies at doubled coarse coordinate k = k0 + j relative to coarse_lo: on node k/2 (k even)
+  /// or half way, between the four nodes from (k − 1)/2 − 1 (k odd).
+  struct FaceAxis {
+    int fine_lo = 0, fine = 1, coarse_lo = 0, coarse = 1, k0 = 0;
+    /// First coarse node (relative) and count (1 or 4) of fine coordinate j's stencil.
+    std::pair<int, int> stencil(int j) const {
+      const int k = k0 + j;
+      return k % 2 == 0 ? std::pair{k / 2, 1} : std::pair{(k - 1) / 2 - 1, 4};
+    }
+    /// Values at the fine coordinates from a row of coarse values (the even and odd
+    /// coordinates as two strided vector loops).
+    void interpolate(const T* coarse_row, T* fine_row) const {
+      const int on = k0 % 2 == 0 ? 0 : 1;  // first fine coordinate on a node
+      const int on_first = (k0 + on) / 2, mid_first = (k0 + 1 - on - 1) / 2 - 1;
+      for (int j = on, c = on_first; j < fine; j += 2, ++c) fine_row[j] = coarse_row[c];
+      for (int j = 1 - on, c = mid_first; j < fine; j += 2, ++c)
+        fine_row[j] = midpoint(coarse_row[c], coarse_row[c + 1], coarse_row[c + 2], coarse_row[c + 3]);
+    }
+  };
+  /// A face of the ghost ring (see the file comment): normal axis, side, in-face axes u and v
+  /// (in 2D v has one coordinate, on node), and where its data lie in the flat arrays.
+  /// Fine rows fv0 … fv1 − 1 of a face, filled by one thread from its coarse rows cv0 … cv1 − 1.
+  struct Chunk {
+    int face, fv0, fv1, cv0, cv1;
+  };
+  /// Fine rows per chunk: the chunk's rows along u stay in the thread's cache; neighbouring
+  /// chunks share up to three coarse rows, interpolated by both.
+  static constexpr int chunk_rows = 16;
+  struct Face {
+    std::array<FaceAxis, 2> axis;
+    int row = 0;                     // ghosts per row along u, rounded up to whole batches
+    std::size_t first_source = 0;    // its coarse plane in sources_ (v-major rows along u)
+    std::ptrdiff_t first_ghost = 0;  // its ghosts in ghosts_ (fine v × row)
   };
   struct Link {
     int i;
@@ -244,47 +298,89 @@ class TwoLevel {
     return k2;
   }
 
-  void build_ghost_stencils() {
-    std::map<std::ptrdiff_t, std::size_t> source_of;  // coarse node -> index in sources_
-    field::for_each_ghost<D>(fine_, [&](const Index<D>& h) {
-      const int first_link = static_cast<int>(links_.size());
-      for (int i = 0; i < Q; ++i) {
-        Index<D> t;
-        for (int a = 0; a < D; ++a) t[a] = h[a] + L::c[i][a];
-        if (fine_.is_interior(t)) links_.push_back({i, fine_.index(t)});
+  /// The faces of the ghost ring with their coarse planes (sources_), the rows to fill and the
+  /// ghosts' links into the fine interior.
+  void build_faces() {
+    const Index<D> nf = fine_.n();
+    for (int a = 0; a < D; ++a)
+      for (int side = 0; side < 2; ++side) {
+        Face fc;
+        std::array<int, 2> ax{-1, -1};
+        for (int b = 0, k = 0; b < D; ++b)
+          if (b != a) ax[k++] = b;
+        for (int k = 0; k < 2 && ax[k] >= 0; ++k) {
+          const int b = ax[k];
+          FaceAxis& fa = fc.axis[k];
+          // Axes before the normal: interior range (their ring is another face's); after: ring too.
+          fa.fine_lo = b < a ? 0 : -1;
+          fa.fine = b < a ? nf[b] : nf[b] + 2;
+          // Coarse nodes under the stencils, from the absolute doubled coordinates.
+          const int k2_lo = doubled_coarse_coordinate_along(b, fa.fine_lo);
+          FaceAxis absolute = fa;
+          absolute.coarse_lo = 0;
+          absolute.k0 = k2_lo;
+          int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min();
+          for (int j = 0; j < fa.fine; ++j) {
+            const auto [first, count] = absolute.stencil(j);
+            lo = std::min(lo, first);
+            hi = std::max(hi, first + count - 1);
+          }
+          fa.coarse_lo = lo;
+          fa.coarse = hi - lo + 1;
+          fa.k0 = k2_lo - 2 * lo;
+        }
+        fc.row = (fc.axis[0].fine + batch - 1) / batch * batch;
+        fc.first_source = sources_.size();
+        fc.first_ghost = static_cast<std::ptrdiff_t>(ghosts_.size());
+        const int normal_k2 = doubled_coarse_coordinate_along(a, side == 0 ? -1 : nf[a]);
+        for (int cv = 0; cv < fc.axis[1].coarse; ++cv)
+          for (int cu = 0; cu < fc.axis[0].coarse; ++cu) {
+            Index<D> c{};
+            c[a] = normal_k2 / 2;
+            c[ax[0]] = fc.axis[0].coarse_lo + cu;
+            if (ax[1] >= 0) c[ax[1]] = fc.axis[1].coarse_lo + cv;
+            CAPLAB_CHECK(coarse_.is_interior(c), "fine block too close to the domain boundary for the coupling");
+            sources_.push_back(coarse_.index(c));
+          }
+        for (int fv0 = 0; fv0 < fc.axis[1].fine; fv0 += chunk_rows) {
+          Chunk ch{static_cast<int>(faces_.size()), fv0, std::min(fv0 + chunk_rows, fc.axis[1].fine), 0, 0};
+          ch.cv0 = std::numeric_limits<int>::max();
+          for (int fv = ch.fv0; fv < ch.fv1; ++fv) {
+            const auto [first, count] = fc.axis[1].stencil(fv);
+            ch.cv0 = std::min(ch.cv0, first);
+            ch.cv1 = std::max(ch.cv1, first + count);
+          }
+          chunks_.push_back(ch);
+          max_coarse_u_ = std::max<std::size_t>(max_coarse_u_, fc.axis[0].coarse);
+          scratch_size_ = std::max<std::size_t>(scratch_size_, static_cast<std::size_t>(Q) * (ch.cv1 - ch.cv0) * fc.row);
+        }
+        for (int fv = 0; fv < fc.axis[1].fine; ++fv) {
+          for (int fu = 0; fu < fc.row; ++fu) {
+            const int first_link = static_cast<int>(links_.size());
+            if (fu < fc.axis[0].fine) {
+              Index<D> g{};
+              g[a] = side == 0 ? -1 : nf[a];
+              g[ax[0]] = fc.axis[0].fine_lo + fu;
+              if (ax[1] >= 0) g[ax[1]] = fc.axis[1].fine_lo + fv;
+              for (int i = 0; i < Q; ++i) {
+                Index<D> t;
+                for (int d = 0; d < D; ++d) t[d] = g[d] + L::c[i][d];
+                if (fine_.is_interior(t)) links_.push_back({i, fine_.index(t)});
+              }
+            }
+            // Padding (fu beyond the face) has no link.
+            ghosts_.push_back({first_link, static_cast<int>(links_.size()) - first_link});
+          }
+        }
+        faces_.push_back(fc);
       }
-      const int link_count = static_cast<int>(links_.size()) - first_link;
-      if (link_count == 0) return;
-      const Index<D> k2 = doubled_coarse_coordinate(h);
-      // 1D stencils per axis, then their tensor product.
-      std::array<std::vector<std::pair<int, double>>, D> axis;
-      for (int a = 0; a < D; ++a) {
-        if (k2[a] % 2 == 0) {
-          axis[a] = {{k2[a] / 2, 1.0}};
-        } else {
-          const int lo = (k2[a] - 1) / 2;
-          axis[a] = {{lo - 1, -1.0 / 16}, {lo, 9.0 / 16}, {lo + 1, 9.0 / 16}, {lo + 2, -1.0 / 16}};
-        }
-      }
-      const int first_weight = static_cast<int>(weights_.size());
-      Index<D> pick{};
-      auto recurse = [&](auto&& self, int a, Index<D> c, double w) -> void {
-        if (a == D) {
-          CAPLAB_CHECK(coarse_.is_interior(c), "fine block too close to the domain boundary for the coupling");
-          const auto idx = coarse_.index(c);
-          auto [it, inserted] = source_of.try_emplace(idx, sources_.size());
-          if (inserted) sources_.push_back(idx);
-          weights_.push_back({it->second, w});
-          return;
-        }
-        for (const auto& [ci, wi] : axis[a]) {
-          c[a] = ci;
-          self(self, a + 1, c, w * wi);
-        }
-      };
-      recurse(recurse, 0, pick, 1.0);
-      ghosts_.push_back({first_weight, static_cast<int>(weights_.size()) - first_weight, first_link, link_count});
-    });
+  }
+
+  /// Doubled coarse coordinate along axis a of fine index j along it.
+  int doubled_coarse_coordinate_along(int a, int j) const {
+    Index<D> f{};
+    f[a] = j;
+    return doubled_coarse_coordinate(f)[a];
   }
 
   void build_restriction() {
@@ -343,19 +439,24 @@ class TwoLevel {
 
   void store_level(const field::Populations<L, T>& coarse, int level) {
     const std::size_t S = sources_.size();
-    for (std::size_t s = 0; s < S; ++s)
-      for (int i = 0; i < Q; ++i) history_[(level * S + s) * Q + i] = coarse(i, sources_[s]);
+    const std::array<const T*, Q> P = coarse.bases();
+    T* out = &history_[level * Q * S];
+#pragma omp parallel for collapse(2) schedule(static)
+    for (int i = 0; i < Q; ++i)
+      for (std::size_t k = 0; k < S; ++k) out[i * S + k] = P[i][sources_[k]];
   }
 
   field::Grid<D> coarse_, fine_;
   Taus c_from_f_{1.0, 1.0}, f_from_c_{1.0, 1.0};  // rescaling factors of the even and odd parts
-  std::vector<std::ptrdiff_t> sources_;  // coarse nodes read by the fine ghost stencils
-  std::vector<Weight> weights_;
-  std::vector<Ghost> ghosts_;
+  std::vector<Face> faces_;
+  std::vector<Chunk> chunks_;               // the tasks of fill_fine_ghosts
+  std::vector<std::ptrdiff_t> sources_;     // coarse nodes of the face planes, face after face
+  std::vector<Ghost> ghosts_;               // face after face, rows along u padded to batches
   std::vector<Link> links_;
   NodePairs band_;  // restricted every step
-  std::vector<T> history_;  // [level][source][i]
-  std::vector<T> at_s_;     // [source][i]: the history interpolated to the substep (s > 0) being filled
+  std::vector<T> history_;  // [level][i][source]
+  std::vector<std::vector<T>> scratch_;  // per thread: a coarse row in time, a chunk's rows along u
+  std::size_t max_coarse_u_ = 0, scratch_size_ = 0;
   Index<D> cov_lo_{}, cov_hi_{};
   int newest_ = 0;
   bool primed_ = false;
