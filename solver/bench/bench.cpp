@@ -242,7 +242,8 @@ json run_benchmarks(const BenchOptions& options) {
       "bandwidth instead (the basis of caplab's reports before the in-place kernel).";
   result["mlups_definition"] =
       "steps x updates_per_step / seconds of sim::Fluid::step() (fused in-place collide-push, "
-      "periodic boundary stage; two-level: coarse + 2 x fine interior nodes per coarse step)";
+      "periodic boundary stage; two-level: coarse + 2 x fine interior nodes per coarse step, less the "
+      "covered coarse nodes inside the restricted band, which are not updated)";
   result["rows"] = rows;
 
   if (opt.out) {

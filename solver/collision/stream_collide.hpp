@@ -23,10 +23,10 @@
 
 namespace caplab::collision {
 
-/// Visits all interior rows (x lines) of a grid in parallel: f(row_base, n_x).
+/// Visits all interior rows (x lines) of a grid in parallel: f(row_base, n_x, index of the
+/// row's first node).
 template <int D, class F>
 void parallel_rows(const field::Grid<D>& g, F&& f) {
-  const int nx = g.n()[0];
   const int ny = g.n()[1];
   const int nz = D == 3 ? g.n()[D - 1] : 1;
   const long rows = static_cast<long>(ny) * nz;
@@ -35,7 +35,7 @@ void parallel_rows(const field::Grid<D>& g, F&& f) {
     Index<D> ijk{};
     ijk[1] = static_cast<int>(r % ny);
     if constexpr (D == 3) ijk[2] = static_cast<int>(r / ny);
-    f(g.index(ijk), nx);
+    f(g.index(ijk), ijk);
   }
 }
 
@@ -109,8 +109,27 @@ template <int w, bool Forced, class L, class T, class Op>
   }
 }
 
+/// Updates the n consecutive nodes from `at`: whole vector chunks, prefetching ahead, then the
+/// pieces of the rest.
+template <bool Forced, class L, class T, class Op>
+[[gnu::always_inline]] inline void update_run(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
+                                              std::ptrdiff_t at, int n) {
+  constexpr int W = simd_chunk<T>;
+  const int whole = n - n % W;
+  for (int x0 = 0; x0 < whole; x0 += W) {
+    const std::ptrdiff_t chunk = at + x0;
+    // Past the run's end this reaches the next rows, contiguous in memory (x fastest), which
+    // this thread takes next under the static schedule; past the array's end it is harmless.
+    prefetch_node<L::q>(P, chunk + prefetch_lines * W);
+#pragma omp simd
+    for (int x = 0; x < W; ++x) update_node<Forced, L, T>(P, op, fp, chunk + x);
+  }
+  update_pieces<W / 2, Forced, L, T>(P, op, fp, at + whole, n - whole);
+}
+
 /// The in-place sweep of one time step over the interior of a block, without the parity flip
-/// (stream_collide and stream_collide_forced_at flip it).
+/// (stream_collide and stream_collide_forced_at flip it). The nodes of `skip` are left alone
+/// (their slots keep their values; no other node reads or writes them, field/populations.hpp).
 ///
 /// Each row runs in chunks of simd_chunk<T> nodes with a trip count known at compile time, so
 /// the whole row is vector code, and the rest of the row in pieces of half, a quarter … of a
@@ -122,15 +141,17 @@ template <int w, bool Forced, class L, class T, class Op>
 /// stores of the chunk before (measured 47^3 D3Q19 BGK, 2 threads: double 136, float 106 MLUPS
 /// against 208 / 353 at 48^3; with the shifted chunk first, 87 / 59).
 template <bool Forced, class L, class T, class Op>
-void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>* force) {
-  constexpr int Q = L::q, D = L::d, W = simd_chunk<T>;
+void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>* force,
+           const field::Box<L::d>& skip = {}) {
+  constexpr int Q = L::q, D = L::d;
   const auto& g = pop.grid();
   const std::array<T*, Q> P = pop.bases();
   std::array<const double*, D> fp{};
   if constexpr (Forced)
     for (int a = 0; a < D; ++a) fp[a] = force->comp[a].data();
+  const int nx = g.n()[0];
 
-  parallel_rows<D>(g, [&](std::ptrdiff_t base, int nx) {
+  parallel_rows<D>(g, [&](std::ptrdiff_t base, const Index<D>& row) {
     // Loop invariants in locals: read through the closure they are reloaded every iteration
     // and GCC does not vectorize the loop (measured: D3Q19 double 42 -> 94 MLUPS, 2 threads).
     T* P_l[Q];
@@ -138,16 +159,12 @@ void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField
     const Op op_l = op;
     const double* fp_l[D];
     for (int a = 0; a < D; ++a) fp_l[a] = fp[a];
-    const int whole = nx - nx % W;
-    for (int x0 = 0; x0 < whole; x0 += W) {
-      const std::ptrdiff_t chunk = base + x0;
-      // Past the row's end this reaches the next rows, contiguous in memory (x fastest), which
-      // this thread takes next under the static schedule; past the array's end it is harmless.
-      prefetch_node<Q>(P_l, chunk + prefetch_lines * W);
-#pragma omp simd
-      for (int x = 0; x < W; ++x) update_node<Forced, L, T>(P_l, op_l, fp_l, chunk + x);
+    if (skip.crosses_row(row)) {
+      update_run<Forced, L, T>(P_l, op_l, fp_l, base, skip.lo[0]);
+      update_run<Forced, L, T>(P_l, op_l, fp_l, base + skip.hi[0], nx - skip.hi[0]);
+    } else {
+      update_run<Forced, L, T>(P_l, op_l, fp_l, base, nx);
     }
-    update_pieces<W / 2, Forced, L, T>(P_l, op_l, fp_l, base + whole, nx - whole);
   });
 }
 
@@ -157,8 +174,8 @@ void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField
 /// `force` (lattice units, per node) must be non-null exactly when Forced is true.
 template <bool Forced, class L, class T, class Op>
 void stream_collide(field::Populations<L, T>& pop, const Op& op,
-                    const field::VectorField<L::d, double>* force = nullptr) {
-  sweep<Forced>(pop, op, force);
+                    const field::VectorField<L::d, double>* force = nullptr, const field::Box<L::d>& skip = {}) {
+  sweep<Forced>(pop, op, force, skip);
   pop.flip_parity();
 }
 

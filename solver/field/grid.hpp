@@ -42,6 +42,29 @@ struct AlignedAllocator {
 template <class T>
 using AlignedVector = std::vector<T, AlignedAllocator<T>>;
 
+/// The nodes lo ≤ ijk < hi of a grid (none when hi ≤ lo along an axis).
+template <int D>
+struct Box {
+  Index<D> lo{}, hi{};
+  bool empty() const {
+    for (int a = 0; a < D; ++a)
+      if (hi[a] <= lo[a]) return true;
+    return false;
+  }
+  std::ptrdiff_t size() const {
+    std::ptrdiff_t s = 1;
+    for (int a = 0; a < D; ++a) s *= std::max(0, hi[a] - lo[a]);
+    return s;
+  }
+  /// Whether the row (x line) through ijk crosses the box.
+  bool crosses_row(const Index<D>& ijk) const {
+    if (empty()) return false;
+    for (int a = 1; a < D; ++a)
+      if (ijk[a] < lo[a] || ijk[a] >= hi[a]) return false;
+    return true;
+  }
+};
+
 /// Geometry of a block: number of interior nodes, placement and spacing, ghost-aware strides.
 template <int D>
 class Grid {

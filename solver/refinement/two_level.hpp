@@ -6,8 +6,8 @@
 // are "covered": the fine solution stands for them, so the innermost uncovered ring (AB) of
 // the thesis is fed by the fine solution. Only the outermost covered layer streams into
 // uncovered nodes, so only it is restricted from the coincident fine nodes every step; the
-// covered nodes inside it evolve as a coarse solution that nothing reads (outputs read the
-// fine nodes through them, fine_node_under).
+// covered nodes inside it are not updated at all (idle_coarse; outputs read the fine nodes
+// through them, fine_node_under).
 //
 // Transfers (pre-collision populations, so τ = 1 is not singular, unlike eq. 2.11/2.12):
 //   fine from coarse:  f_f = f_eq + τ_f/(m τ_c) · (f_c − f_eq)
@@ -148,8 +148,8 @@ class TwoLevel {
 
   /// Sets the covered coarse nodes that stream into uncovered ones (the outermost covered
   /// layer) from the coincident fine nodes, at the current time. Deeper covered nodes reach
-  /// nothing outside the fine block before they are overwritten, so they are left to evolve on
-  /// their own; `restrict_everywhere` sets them too, and `fine_node_under` reads through them.
+  /// nothing outside the fine block before they are overwritten, so they are not updated
+  /// (idle_coarse); `restrict_everywhere` sets them too, and `fine_node_under` reads through them.
   void restrict_to_coarse(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine) const {
     restrict_nodes(coarse, fine, band_);
   }
@@ -172,6 +172,15 @@ class TwoLevel {
     ar(prefix + "history", std::span<T>(history_));
     ar(prefix + "newest", newest_);
     ar(prefix + "primed", primed_);
+  }
+
+  /// The covered coarse nodes inside the band: nothing reads them before they are overwritten
+  /// (their pushes reach covered nodes only, and the band is restricted every step), so the
+  /// coarse sweep leaves them alone.
+  field::Box<D> idle_coarse() const {
+    field::Box<D> idle;
+    for (int a = 0; a < D; ++a) idle.lo[a] = cov_lo_[a] + 2, idle.hi[a] = cov_hi_[a] - 1;
+    return idle;
   }
 
   /// Whether a coarse node lies strictly inside the fine block (it is read through the fine grid).

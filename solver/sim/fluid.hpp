@@ -40,6 +40,7 @@ class Fluid {
     Force force;          // allocated when the block is ever forced
     bool has_body_force = false;
     field::AlignedVector<T> forced_scratch;  // stream_collide_forced_at's results, grown as needed
+    field::Box<D> skip;  // nodes its sweep leaves alone: the idle covered nodes of a coarse block
   };
 
   struct Setup {
@@ -61,6 +62,7 @@ class Fluid {
       blocks_.push_back(make_block(*s.fine, fine_op));
       coupling_ = refinement::TwoLevel<L, T>(s.coarse, *s.fine, {s.coarse_op.tau, s.coarse_op.tau_minus()},
                                              {fine_op.tau, fine_op.tau_minus()});
+      blocks_[0].skip = coupling_.idle_coarse();
     }
     coarse_bc_ = boundary::BoundarySet<L, T>(s.coarse, s.boundaries, s.imposed_velocity_lu, s.far_field);
     const bool body = s.body_force_lu.norm() > 0;
@@ -133,15 +135,15 @@ class Fluid {
   /// The uniform body force of block b in its lattice units.
   const Vec<D>& body_force(std::size_t b) const { return body_force_[b]; }
 
-  /// Node updates per coarse step (for MLUPS).
+  /// Node updates per coarse step (for MLUPS): the idle covered nodes are not updated.
   double updates_per_step() const {
-    double u = static_cast<double>(blocks_[0].pop.grid().interior_size());
+    double u = static_cast<double>(blocks_[0].pop.grid().interior_size() - blocks_[0].skip.size());
     if (two_level()) u += 2.0 * static_cast<double>(blocks_[1].pop.grid().interior_size());
     return u;
   }
 
  private:
-  static Block make_block(const field::Grid<D>& g, const Op& op) { return Block{Pop(g), op, Force(0), false, {}}; }
+  static Block make_block(const field::Grid<D>& g, const Op& op) { return Block{Pop(g), op, Force(0), false, {}, {}}; }
 
   /// One step of a block: forcing hook, then the boundaries' stage before the in-place sweep
   /// (what reads the state at time t), the sweep, and the stage that fills the entering slots.
@@ -158,11 +160,11 @@ class Fluid {
     }
     before_sweep();
     if (blk.has_body_force)
-      collision::stream_collide<true>(blk.pop, blk.op, &blk.force);
+      collision::stream_collide<true>(blk.pop, blk.op, &blk.force, blk.skip);
     else if (!forced.empty())
       collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced, blk.forced_scratch);
     else
-      collision::stream_collide<false>(blk.pop, blk.op);
+      collision::stream_collide<false>(blk.pop, blk.op, nullptr, blk.skip);
     apply_boundaries();
   }
 
