@@ -289,18 +289,6 @@ template <int W, class Body>
   for_each_in_chunks<W>(static_cast<std::ptrdiff_t>(region.nodes.size()), listed);
 }
 
-/// The forced velocity u = Σ c_i f_i / ρ + F / (2ρ) of node n into up[a][n], in double
-/// precision (the markers' velocity, whatever the populations' precision).
-template <class L, class Ptr>
-[[gnu::always_inline]] inline void forced_velocity_of_node(const Ptr (&P)[L::q], const double* const (&fp)[L::d],
-                                                           double* const (&up)[L::d], std::ptrdiff_t n) {
-  double f[L::q], rho, v[L::d];
-#pragma GCC unroll 19
-  for (int i = 0; i < L::q; ++i) f[i] = P[i][n];
-  moments<L, double>(f, rho, v);
-  for (int a = 0; a < L::d; ++a) up[a][n] = v[a] + fp[a][n] / (2.0 * rho);
-}
-
 /// One time step of a block with Guo forcing at the nodes of `region` only (the force must be
 /// zero off region.nodes; the nodes between them that its spans visit take the forced update
 /// with zero force: the unforced one up to round-off), then the parity flip. This keeps the
@@ -308,13 +296,10 @@ template <class L, class Ptr>
 /// be updated twice: the region's forced results go to `scratch` (Q values per visited node,
 /// resized when too small) before the unforced sweep of the whole block, and over the sweep's
 /// results at those nodes after it; every slot belongs to one node, so nothing else changes.
-/// With `velocity`, also writes there the forced velocity of the collided state at the visited
-/// nodes, as forced_velocity_at (the same double-precision formula, from the populations the
-/// collision has loaded anyway).
 template <class L, class T, class Op>
 void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op,
                               const field::VectorField<L::d, double>& force, const ForcedRegion& region,
-                              field::AlignedVector<T>& scratch, field::VectorField<L::d, double>* velocity = nullptr) {
+                              field::AlignedVector<T>& scratch) {
   constexpr int Q = L::q, D = L::d;
   const std::ptrdiff_t M = region.visited();
   if (static_cast<std::ptrdiff_t>(scratch.size()) < Q * M) scratch.resize(static_cast<std::size_t>(Q * M));
@@ -334,17 +319,7 @@ void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op,
 #pragma GCC unroll 19
     for (int i = 0; i < Q; ++i) out[i * M + k] = post[i];
   };
-  if (velocity) {
-    double* up[D];
-    for (int a = 0; a < D; ++a) up[a] = velocity->comp[a].data();
-    auto forced_and_velocity = [=](std::ptrdiff_t n, std::ptrdiff_t k) __attribute__((always_inline)) {
-      forced(n, k);
-      forced_velocity_of_node<L>(P, fp, up, n);
-    };
-    for_each_forced_node<simd_chunk<T>>(region, forced_and_velocity);
-  } else {
-    for_each_forced_node<simd_chunk<T>>(region, forced);
-  }
+  for_each_forced_node<simd_chunk<T>>(region, forced);
   sweep<false>(pop, op, nullptr);
   auto put = [=](std::ptrdiff_t n, std::ptrdiff_t k) __attribute__((always_inline)) {
 #pragma GCC unroll 19
@@ -368,7 +343,11 @@ void forced_velocity_at(const field::Populations<L, T>& pop, const field::Vector
   double* up[D];
   for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data(), up[a] = u.comp[a].data();
   auto body = [=](std::ptrdiff_t n, std::ptrdiff_t) __attribute__((always_inline)) {
-    forced_velocity_of_node<L>(P, fp, up, n);
+    double f[Q], rho, v[D];
+#pragma GCC unroll 19
+    for (int i = 0; i < Q; ++i) f[i] = P[i][n];
+    moments<L, double>(f, rho, v);
+    for (int a = 0; a < D; ++a) up[a][n] = v[a] + fp[a][n] / (2.0 * rho);
   };
   for_each_forced_node<simd_chunk<T>>(region, body);
 }

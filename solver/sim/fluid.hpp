@@ -33,15 +33,6 @@ class Fluid {
   /// whole field every substep. Without a uniform body force only the returned region takes
   /// the forced kernel (stream_collide_forced_at); with one, the whole block does.
   using ForcingHook = std::function<collision::ForcedRegion(const Pop&, Force&)>;
-  /// What else the finest block's step does for the IB: `velocity`, when given, receives at the
-  /// nodes of the hook's region the forced velocity of the state the sweep collides
-  /// (collision::forced_velocity_at; the forced collision computes it from the populations it
-  /// loads anyway), and `after_sweep` runs after each of the finest block's sweeps (the markers'
-  /// move with that velocity).
-  struct FinestStage {
-    Force* velocity = nullptr;
-    std::function<void()> after_sweep;
-  };
 
   struct Block {
     Pop pop;
@@ -101,19 +92,19 @@ class Fluid {
   }
 
   /// One coarse time step (and m = 2 fine substeps). `hook` forces the finest block.
-  void step(const ForcingHook& hook = {}, const FinestStage& finest = {}) {
+  void step(const ForcingHook& hook = {}) {
     auto& c = blocks_[0];
     auto coarse_before = [&] { coarse_bc_.prepare(c.pop, c.op); };
     auto coarse_after = [&] { coarse_bc_.apply(c.pop); };
     if (!two_level()) {
-      advance_block(c, hook, finest, coarse_before, coarse_after);
+      advance_block(c, hook, coarse_before, coarse_after);
       return;
     }
-    advance_block(c, {}, {}, coarse_before, coarse_after);
+    advance_block(c, {}, coarse_before, coarse_after);
     core::timed(coupling_seconds_, [&] { coupling_.capture_coarse(c.pop); });
     auto& f = blocks_[1];
     for (int sub = 0; sub < 2; ++sub)
-      advance_block(f, hook, finest, [] {}, [&] {
+      advance_block(f, hook, [] {}, [&] {
         core::timed(coupling_seconds_, [&] { coupling_.fill_fine_ghosts(f.pop, f.op, 0.5 * sub); });
       });
     core::timed(coupling_seconds_, [&] { coupling_.restrict_to_coarse(c.pop, f.pop); });
@@ -157,8 +148,7 @@ class Fluid {
   /// One step of a block: forcing hook, then the boundaries' stage before the in-place sweep
   /// (what reads the state at time t), the sweep, and the stage that fills the entering slots.
   template <class Before, class After>
-  void advance_block(Block& blk, const ForcingHook& hook, const FinestStage& stage, Before&& before_sweep,
-                     After&& apply_boundaries) {
+  void advance_block(Block& blk, const ForcingHook& hook, Before&& before_sweep, After&& apply_boundaries) {
     const std::size_t b = &blk - blocks_.data();
     collision::ForcedRegion forced;
     if (hook) {
@@ -169,15 +159,12 @@ class Fluid {
       forced = hook(blk.pop, blk.force);
     }
     before_sweep();
-    if (blk.has_body_force) {
-      if (stage.velocity && !forced.empty()) collision::forced_velocity_at<L, T>(blk.pop, blk.force, forced, *stage.velocity);
+    if (blk.has_body_force)
       collision::stream_collide<true>(blk.pop, blk.op, &blk.force, blk.skip);
-    } else if (!forced.empty()) {
-      collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced, blk.forced_scratch, stage.velocity);
-    } else {
+    else if (!forced.empty())
+      collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced, blk.forced_scratch);
+    else
       collision::stream_collide<false>(blk.pop, blk.op, nullptr, blk.skip);
-    }
-    if (stage.after_sweep) stage.after_sweep();
     apply_boundaries();
   }
 

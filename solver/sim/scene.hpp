@@ -151,14 +151,11 @@ class Scene {
     auto last_checkpoint = clock::now();
     auto last_report = clock::now();
     auto hook = [&](const typename FluidT::Pop& pop, typename FluidT::Force& f) { return apply_ib(pop, f); };
-    // The capsules move with the forced velocity that the forced collision computes.
-    typename FluidT::FinestStage finest;
-    if (!capsules_.empty()) finest = {&forced_velocity_, [&] { advect_capsules(); }};
     std::vector<double> row(width);
     try {
       for (long step = step_ + 1; step <= total; ++step) {
         step_ = step;
-        core::timed(seconds_fluid_, [&] { fluid_.step(hook, finest); });
+        core::timed(seconds_fluid_, [&] { fluid_.step(hook); });
         const double t = step * dt;
         if (!capsules_.empty()) core::timed(seconds_diagnostics_, [&] { track_capsules(); });
         const bool checkpoint_due =
@@ -520,27 +517,21 @@ class Scene {
   }
   collision::ForcedRegion forced_region() const { return {forced_nodes_, forced_spans_}; }
 
-  /// Membrane forces and spreading (capsule.hpp); the markers move after the sweep
-  /// (advect_capsules).
+  /// Membrane forces, spreading, and the markers' move with the forced velocity (capsule.hpp).
   void move_capsules(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
     core::timed(seconds_membrane_, [&] {
       for (auto& c : capsules_) c.compute_forces();
     });
     core::timed(seconds_ib_, [&] {
       for (auto& c : capsules_) guarded(c, [&] { c.spread(pop.grid(), periodic_, f); });
+      // The velocity the forced collision uses, once per stencil node (stencils overlap).
       collect_forced_nodes(pop.grid());
-      // The forced velocity of the collided state, once per stencil node (stencils overlap),
-      // goes into a block-sized field (only at the stencil nodes, which are all the
+      // Written into a block-sized field (only at the stencil nodes, which are all the
       // interpolation reads), so that the interpolation reads rows of consecutive nodes.
       if (static_cast<std::ptrdiff_t>(forced_velocity_.comp[0].size()) != pop.grid().size())
         forced_velocity_ = field::VectorField<D>(pop.grid().size());
-    });
-  }
-
-  /// The markers' move with the forced velocity of the step just swept (Fluid::FinestStage).
-  void advect_capsules() {
-    core::timed(seconds_ib_, [&] {
-      for (auto& c : capsules_) c.advect(forced_velocity_, fluid_.finest().pop.grid().dx());
+      collision::forced_velocity_at<L, T>(pop, f, forced_region(), forced_velocity_);
+      for (auto& c : capsules_) c.advect(forced_velocity_, pop.grid().dx());
     });
   }
 
