@@ -243,7 +243,7 @@ json run_benchmarks(const BenchOptions& options) {
   result["mlups_definition"] =
       "steps x updates_per_step / seconds of sim::Fluid::step() (fused in-place collide-push, "
       "periodic boundary stage; two-level: coarse + 2 x fine interior nodes per coarse step, less the "
-      "covered coarse nodes inside the restricted band, which are not updated)";
+      "covered coarse nodes, for which the fine block stands)";
   result["rows"] = rows;
 
   if (opt.out) {

@@ -5,7 +5,7 @@
 // Taylor–Green perturbation: it neither decays to rest (no subnormal numbers) nor diverges.
 // Two-level: the coarse box with a centred fine block (m = 2) covering about 1/8 of its
 // volume; one step is one coarse step, two fine substeps and the coupling, and counts
-// coarse + 2 × fine interior nodes, less the idle covered coarse nodes (Fluid::updates_per_step).
+// coarse + 2 × fine interior nodes, less the covered coarse nodes (Fluid::updates_per_step).
 // Timing: one warm-up step, then batches of steps (each about 1/5 of the minimum time) until
 // the minimum time has passed and at least three batches ran; a two-level case alternates its
 // batches with those of its uniform twin (same coarse box), and its overhead is the median of

@@ -4,10 +4,12 @@
 // Layout. The coarse grid covers the whole domain. The fine block's ghost ring is the line
 // (surface) MN of thesis fig. 2.2 and lies on coarse nodes; coarse nodes strictly inside MN
 // are "covered": the fine solution stands for them, so the innermost uncovered ring (AB) of
-// the thesis is fed by the fine solution. Only the outermost covered layer streams into
-// uncovered nodes, so only it is restricted from the coincident fine nodes every step; the
-// covered nodes inside it are not updated at all (idle_coarse; outputs read the fine nodes
-// through them, fine_node_under).
+// the thesis is fed by the fine solution. Only the outermost covered layer (the band) streams
+// into uncovered nodes, so only its step is taken, by the coupling (collide_band): each band
+// node's populations restricted from its coincident fine node, collided with the coarse
+// operator, pushed along the links that leave the covered region. The coarse sweep leaves the
+// whole covered region alone (idle_coarse; outputs read the fine nodes through it,
+// fine_node_under).
 //
 // Transfers (pre-collision populations, so τ = 1 is not singular, unlike eq. 2.11/2.12):
 //   fine from coarse:  f_f = f_eq + τ_f/(m τ_c) · (f_c − f_eq)
@@ -29,9 +31,9 @@
 // first in-face axis u onto the fine spacing, then along the second, v (3D), row by row just
 // before the row's ghosts are collided. The history keeps the coarse planes, not whole nodes.
 //
-// One coarse step: coarse collide-push (in place, parity flip) + boundaries, capture_coarse();
-// two fine substeps, each: collide-push, fill_fine_ghosts(s) with s = 0 then ½; then
-// restrict_to_coarse(). Populations are addressed at each block's current parity
+// One coarse step: collide_band(), the coarse collide-push (in place, parity flip) +
+// boundaries, capture_coarse(); two fine substeps, each: collide-push, fill_fine_ghosts(s) with
+// s = 0 then ½. Populations are addressed at each block's current parity
 // (field/populations.hpp). Exactness: uniform and linear shear flows cross the interface
 // unchanged to round-off (tests/verification).
 #pragma once
@@ -41,11 +43,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <utility>
 #include <vector>
 
 #include "collision/equilibrium.hpp"
+#include "collision/stream_collide.hpp"
 #include "core/error.hpp"
 #include "field/populations.hpp"
 
@@ -146,12 +150,48 @@ class TwoLevel {
     }
   }
 
-  /// Sets the covered coarse nodes that stream into uncovered ones (the outermost covered
-  /// layer) from the coincident fine nodes, at the current time. Deeper covered nodes reach
-  /// nothing outside the fine block before they are overwritten, so they are not updated
-  /// (idle_coarse); `restrict_everywhere` sets them too, and `fine_node_under` reads through them.
-  void restrict_to_coarse(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine) const {
-    restrict_nodes(coarse, fine, band_);
+  /// The band's part of the coarse step (call before the coarse sweep, at the time level of
+  /// both blocks): each band node's populations restricted from its coincident fine node and
+  /// collided with the coarse operator, as the coarse sweep would (Guo forcing with the uniform
+  /// body force F when Forced), and written where the sweep writes them, along the links that
+  /// leave the covered region only: the others reach covered nodes, which nothing reads.
+  /// Restricting the band after the fine substeps and colliding it in the sweep wrote all Q
+  /// populations of every band node twice, scattered (the faces normal to x a cache line each).
+  template <bool Forced, class Op>
+  void collide_band(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine, const Op& op,
+                    const T (&F)[D]) const {
+    const std::array<const T*, Q> src = fine.bases();
+    const std::array<T*, Q> dst = coarse.bases();
+    const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(band_.coarse.size()) / batch;
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t bt = 0; bt < batches; ++bt) {
+      const std::ptrdiff_t k0 = bt * batch;
+      T post[Q][batch];
+#pragma omp simd
+      for (int b = 0; b < batch; ++b) {
+        T f[Q], feq[Q], out[Q];
+#pragma GCC unroll 19
+        for (int i = 0; i < Q; ++i) f[i] = src[i][band_.fine[k0 + b]];
+        rescale_non_equilibrium(f, feq, c_from_f_);
+        // As collision::update_node, from the moments of the restricted populations.
+        if constexpr (Forced) {
+          collision::collide_forced<L, T>(f, F, op, out);
+        } else {
+          T rho, u[D];
+          collision::moments<L, T>(f, rho, u);
+          collision::equilibrium<L, T>(rho, u, feq);
+          op.template collide<L, T>(f, feq, out);
+        }
+#pragma GCC unroll 19
+        for (int i = 0; i < Q; ++i) post[i][b] = out[i];
+      }
+      for (int b = 0; b < batch; ++b) {
+        const std::ptrdiff_t n = band_.coarse[k0 + b];
+        const std::uint32_t leaving = band_leaving_[k0 + b];
+        for (int i = 0; i < Q; ++i)
+          if (leaving >> i & 1U) dst[L::opposite[i]][n] = post[i][b];
+      }
+    }
   }
 
   /// Sets every covered coarse node from the fine block (the initial state).
@@ -174,12 +214,11 @@ class TwoLevel {
     ar(prefix + "primed", primed_);
   }
 
-  /// The covered coarse nodes inside the band: nothing reads them before they are overwritten
-  /// (their pushes reach covered nodes only, and the band is restricted every step), so the
-  /// coarse sweep leaves them alone.
+  /// The covered coarse nodes, which the coarse sweep leaves alone: the band's step is
+  /// collide_band's, and nothing reads the nodes inside it.
   field::Box<D> idle_coarse() const {
     field::Box<D> idle;
-    for (int a = 0; a < D; ++a) idle.lo[a] = cov_lo_[a] + 2, idle.hi[a] = cov_hi_[a] - 1;
+    for (int a = 0; a < D; ++a) idle.lo[a] = cov_lo_[a] + 1, idle.hi[a] = cov_hi_[a];
     return idle;
   }
 
@@ -405,6 +444,22 @@ class TwoLevel {
       cov_hi_[a] = hi2[a] / 2;
     }
     band_ = covered_pairs(true);
+    // The links of each band node that leave the covered region.
+    for (std::size_t k = 0; k < band_.coarse.size(); ++k) {
+      Index<D> c;
+      std::ptrdiff_t rest = band_.coarse[k];
+      for (int a = D - 1; a >= 0; --a) {
+        c[a] = static_cast<int>(rest / coarse_.stride(a)) - 1;
+        rest %= coarse_.stride(a);
+      }
+      std::uint32_t leaving = 0;
+      for (int i = 0; i < Q; ++i) {
+        Index<D> t;
+        for (int a = 0; a < D; ++a) t[a] = c[a] + L::c[i][a];
+        if (!covered(t)) leaving |= 1U << i;
+      }
+      band_leaving_.push_back(leaving);
+    }
   }
 
   /// Covered coarse nodes and their fine nodes: all, or only the band (one link, max norm,
@@ -462,7 +517,8 @@ class TwoLevel {
   std::vector<std::ptrdiff_t> sources_;     // coarse nodes of the face planes, face after face
   std::vector<Ghost> ghosts_;               // face after face, rows along u padded to batches
   std::vector<Link> links_;
-  NodePairs band_;  // restricted every step
+  NodePairs band_;                         // the outermost covered layer (collide_band)
+  std::vector<std::uint32_t> band_leaving_;  // per band node: bit i set when link i leaves the covered region
   std::vector<T> history_;  // [level][i][source]
   std::vector<std::vector<T>> scratch_;  // per thread: a coarse row in time, a chunk's rows along u
   std::size_t max_coarse_u_ = 0, scratch_size_ = 0;

@@ -40,7 +40,7 @@ class Fluid {
     Force force;          // allocated when the block is ever forced
     bool has_body_force = false;
     field::AlignedVector<T> forced_scratch;  // stream_collide_forced_at's results, grown as needed
-    field::Box<D> skip;  // nodes its sweep leaves alone: the idle covered nodes of a coarse block
+    field::Box<D> skip;  // nodes its sweep leaves alone: the covered nodes of a coarse block
   };
 
   struct Setup {
@@ -100,14 +100,24 @@ class Fluid {
       advance_block(c, hook, coarse_before, coarse_after);
       return;
     }
-    advance_block(c, {}, coarse_before, coarse_after);
-    core::timed(coupling_seconds_, [&] { coupling_.capture_coarse(c.pop); });
     auto& f = blocks_[1];
+    auto coarse_and_band_before = [&] {
+      coarse_before();
+      core::timed(coupling_seconds_, [&] {
+        T F[D];
+        for (int a = 0; a < D; ++a) F[a] = T(body_force_[0][a]);
+        if (c.has_body_force)
+          coupling_.template collide_band<true>(c.pop, f.pop, c.op, F);
+        else
+          coupling_.template collide_band<false>(c.pop, f.pop, c.op, F);
+      });
+    };
+    advance_block(c, {}, coarse_and_band_before, coarse_after);
+    core::timed(coupling_seconds_, [&] { coupling_.capture_coarse(c.pop); });
     for (int sub = 0; sub < 2; ++sub)
       advance_block(f, hook, [] {}, [&] {
         core::timed(coupling_seconds_, [&] { coupling_.fill_fine_ghosts(f.pop, f.op, 0.5 * sub); });
       });
-    core::timed(coupling_seconds_, [&] { coupling_.restrict_to_coarse(c.pop, f.pop); });
   }
 
   /// The evolving state (io/checkpoint.hpp archive): populations of every block and the coarse
@@ -135,7 +145,8 @@ class Fluid {
   /// The uniform body force of block b in its lattice units.
   const Vec<D>& body_force(std::size_t b) const { return body_force_[b]; }
 
-  /// Node updates per coarse step (for MLUPS): the idle covered nodes are not updated.
+  /// Node updates per coarse step (for MLUPS): not the covered coarse nodes, for which the fine
+  /// block stands.
   double updates_per_step() const {
     double u = static_cast<double>(blocks_[0].pop.grid().interior_size() - blocks_[0].skip.size());
     if (two_level()) u += 2.0 * static_cast<double>(blocks_[1].pop.grid().interior_size());
