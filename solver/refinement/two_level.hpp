@@ -283,8 +283,6 @@ class TwoLevel {
         fine_row[j] = midpoint(coarse_row[c], coarse_row[c + 1], coarse_row[c + 2], coarse_row[c + 3]);
     }
   };
-  /// A face of the ghost ring (see the file comment): normal axis, side, in-face axes u and v
-  /// (in 2D v has one coordinate, on node), and where its data lie in the flat arrays.
   /// Fine rows fv0 … fv1 − 1 of a face, filled by one thread from its coarse rows cv0 … cv1 − 1.
   struct Chunk {
     int face, fv0, fv1, cv0, cv1;
@@ -292,6 +290,8 @@ class TwoLevel {
   /// Fine rows per chunk: the chunk's rows along u stay in the thread's cache; neighbouring
   /// chunks share up to three coarse rows, interpolated by both.
   static constexpr int chunk_rows = 16;
+  /// A face of the ghost ring (see the file comment): normal axis, side, in-face axes u and v
+  /// (in 2D v has one coordinate, on node), and where its data lie in the flat arrays.
   struct Face {
     std::array<FaceAxis, 2> axis;
     int row = 0;                     // ghosts per row along u, rounded up to whole batches
