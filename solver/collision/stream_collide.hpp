@@ -23,8 +23,8 @@
 
 namespace caplab::collision {
 
-/// Visits all interior rows (x lines) of a grid in parallel: f(row_base, n_x, index of the
-/// row's first node).
+/// Visits all interior rows (x lines) of a grid in parallel: f(row_base, index of the row's
+/// first node).
 template <int D, class F>
 void parallel_rows(const field::Grid<D>& g, F&& f) {
   const int ny = g.n()[1];
