@@ -8,6 +8,7 @@
 // a constant offset in the linear index.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdlib>
 #include <memory>
