@@ -68,6 +68,22 @@ template <int Q, class T>
   for (int i = 0; i < Q; ++i) __builtin_prefetch(P[i] + n, 1, 3);
 }
 
+/// The fused kernel's collision of one node's populations f (Guo-forced with F when Forced;
+/// F is not read otherwise). Also the band's step of a two-level coupling
+/// (refinement/two_level.hpp), which must collide exactly as the sweep would.
+template <bool Forced, class L, class T, class Op>
+[[gnu::always_inline]] inline void collide_node(const T (&f)[L::q], const T (&F)[L::d], const Op& op,
+                                                T (&out)[L::q]) {
+  if constexpr (Forced) {
+    collide_forced<L, T>(f, F, op, out);
+  } else {
+    T rho, u[L::d], feq[L::q];
+    moments<L, T>(f, rho, u);
+    equilibrium<L, T>(rho, u, feq);
+    op.template collide<L, T>(f, feq, out);
+  }
+}
+
 /// Collide-and-push of node n in place (the body of the fused kernel's vector loop): reads
 /// f_i from P[i][n], writes the post-collision value i to P[ī][n] (field/populations.hpp: the
 /// same Q slots, and where the next step at the other parity finds it at node n + c_i).
@@ -76,18 +92,12 @@ template <bool Forced, class L, class T, class Op>
 [[gnu::always_inline]] inline void update_node(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
                                                std::ptrdiff_t n) {
   constexpr int Q = L::q, D = L::d;
-  T f[Q], feq[Q], out[Q], rho, u[D];
+  T f[Q], F[D], out[Q];
 #pragma GCC unroll 19
   for (int i = 0; i < Q; ++i) f[i] = P[i][n];
-  if constexpr (Forced) {
-    T F[D];
+  if constexpr (Forced)
     for (int a = 0; a < D; ++a) F[a] = T(fp[a][n]);
-    collide_forced<L, T>(f, F, op, out);
-  } else {
-    moments<L, T>(f, rho, u);
-    equilibrium<L, T>(rho, u, feq);
-    op.template collide<L, T>(f, feq, out);
-  }
+  collide_node<Forced, L, T>(f, F, op, out);
 #pragma GCC unroll 19
   for (int i = 0; i < Q; ++i) P[L::opposite[i]][n] = out[i];
 }

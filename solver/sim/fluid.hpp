@@ -85,10 +85,7 @@ class Fluid {
       const auto& g = blk.pop.grid();
       collision::initialise_equilibrium(blk.pop, [&](const Index<D>& ijk) { return init(g.position(ijk)); });
     }
-    if (two_level()) {
-      coupling_.restrict_everywhere(blocks_[0].pop, blocks_[1].pop);
-      coupling_.capture_coarse(blocks_[0].pop);
-    }
+    if (two_level()) coupling_.capture_coarse(blocks_[0].pop);
   }
 
   /// One coarse time step (and m = 2 fine substeps). `hook` forces the finest block.
