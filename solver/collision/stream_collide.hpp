@@ -194,8 +194,8 @@ void stream_collide(field::Populations<L, T>& pop, const Op& op,
 /// parallel, then the rest as one chunk shifted back to end at count − 1, after the parallel
 /// loop. That chunk redoes indices of the last whole chunk, so body(k) must write the same
 /// values each time and nothing that another k reads. Mark a lambda body
-/// `__attribute__((always_inline))`: GCC 12 otherwise calls the forced collision's body out of
-/// line and leaves the chunk loop scalar.
+/// `__attribute__((always_inline))`: GCC 12 otherwise calls a body as heavy as a node's moments
+/// out of line and leaves the chunk loop scalar.
 template <int W, class Body>
 [[gnu::always_inline]] inline void for_each_in_chunks(std::ptrdiff_t count, const Body& body) {
   if (count < W) {
@@ -215,13 +215,9 @@ template <int W, class Body>
   }
 }
 
-/// Consecutive linear indices [begin, end) inside one row's interior, at least one chunk long;
-/// `first` numbers its nodes densely across the spans of a region (node begin + j is number
-/// first + j), for per-node scratch such as the forced collision's results.
+/// Consecutive linear indices [begin, end) inside one row's interior, at least one chunk long.
 struct NodeSpan {
-  std::ptrdiff_t begin, end, first = 0;
-  /// The number of the node after the span's last (the next span's `first`).
-  std::ptrdiff_t past_last() const { return first + end - begin; }
+  std::ptrdiff_t begin, end;
 };
 
 /// The nodes a forcing stage visits: distinct interior nodes in memory order and, where the
@@ -230,10 +226,6 @@ struct ForcedRegion {
   std::span<const std::ptrdiff_t> nodes;
   std::span<const NodeSpan> spans;
   bool empty() const { return nodes.empty(); }
-  /// Nodes the walkers visit: the spans' nodes, or the listed ones (the dense numbering).
-  std::ptrdiff_t visited() const {
-    return spans.empty() ? static_cast<std::ptrdiff_t>(nodes.size()) : spans.back().past_last();
-  }
 };
 
 /// Covers the sorted distinct interior nodes `nodes` of grid g with spans of at least W nodes,
@@ -243,8 +235,7 @@ struct ForcedRegion {
 /// Nodes of one row less than 2W apart share a span (the nodes between are visited too); a
 /// span shorter than W grows to W inside its row, backwards at the row's end. Spans are
 /// disjoint: two spans of one row are at least 2W − 1 apart before growing and each grows by
-/// less than W; their nodes are numbered densely in order (NodeSpan::first). Leaves `spans`
-/// empty when the rows are shorter than W. W is the walker's chunk
+/// less than W. Leaves `spans` empty when the rows are shorter than W. W is the walker's chunk
 /// (for_each_in_spans<W>, a span shorter than it would be overrun): both take it at compile
 /// time, simd_chunk<T> of the populations.
 template <int W, int D>
@@ -262,12 +253,11 @@ void cover_with_spans(const field::Grid<D>& g, std::span<const std::ptrdiff_t> n
       begin = std::min(begin, row_hi - W);
       end = begin + W;
     }
-    spans.push_back({begin, end, spans.empty() ? 0 : spans.back().past_last()});
+    spans.push_back({begin, end});
   }
 }
 
-/// Runs body(n, k) for every node n of the spans (cover_with_spans<W>), k its dense number:
-/// each span as whole chunks of W consecutive nodes, one `omp simd` loop each, the last shifted
+/// Runs body(n) for every node n of the spans (cover_with_spans<W>): each span as whole chunks of W consecutive nodes, one `omp simd` loop each, the last shifted
 /// back to end at the span's end (it redoes nodes, so body must write the same values each time
 /// and nothing another node reads); the spans in parallel (they are disjoint).
 template <int W, class Body>
@@ -278,16 +268,14 @@ template <int W, class Body>
     const NodeSpan span = spans[s];
     for (std::ptrdiff_t c0 = span.begin; c0 < span.end; c0 += W) {
       const std::ptrdiff_t c = std::min(c0, span.end - W);
-      const std::ptrdiff_t k = span.first + (c - span.begin);
 #pragma omp simd
-      for (int j = 0; j < W; ++j) body(c + j, k + j);
+      for (int j = 0; j < W; ++j) body(c + j);
     }
   }
 }
 
-/// body(n, k) for the nodes of `region`, k the dense number of n (ForcedRegion::visited): over
-/// its spans where it has them, otherwise over the node list (for_each_in_chunks, gathers and
-/// scatters).
+/// body(n) for the nodes of `region`: over its spans where it has them, otherwise over the
+/// node list (for_each_in_chunks, gathers and scatters).
 template <int W, class Body>
 [[gnu::always_inline]] inline void for_each_forced_node(const ForcedRegion& region, const Body& body) {
   if (!region.spans.empty()) {
@@ -295,47 +283,68 @@ template <int W, class Body>
     return;
   }
   const std::ptrdiff_t* node = region.nodes.data();
-  auto listed = [&](std::ptrdiff_t k) __attribute__((always_inline)) { body(node[k], k); };
+  auto listed = [&](std::ptrdiff_t k) __attribute__((always_inline)) { body(node[k]); };
   for_each_in_chunks<W>(static_cast<std::ptrdiff_t>(region.nodes.size()), listed);
+}
+
+/// update_run as a call (noinline, flattened): a row cut into stretches calls it several times,
+/// and inlined so often into the row loop GCC 12 would run out of inlining budget and leave the
+/// collision out of line (see update_pieces).
+template <bool Forced, class L, class T, class Op>
+[[gnu::noinline, gnu::flatten]] void update_stretch(T* const (&P)[L::q], const Op& op,
+                                                  const double* const (&fp)[L::d], std::ptrdiff_t at, int n) {
+  update_run<Forced, L, T>(P, op, fp, at, n);
 }
 
 /// One time step of a block with Guo forcing at the nodes of `region` only (the force must be
 /// zero off region.nodes; the nodes between them that its spans visit take the forced update
 /// with zero force: the unforced one up to round-off), then the parity flip. This keeps the
-/// forced kernel, about twice the cost per node, to the IB's stencils. In place, a node cannot
-/// be updated twice: the region's forced results go to `scratch` (Q values per visited node,
-/// resized when too small) before the unforced sweep of the whole block, and over the sweep's
-/// results at those nodes after it; every slot belongs to one node, so nothing else changes.
+/// forced kernel, about twice the cost per node, to the IB's stencils. One sweep: each row runs
+/// the region's stretches in it (its spans, or its listed nodes one by one where the rows are
+/// too short for spans) with the forced kernel and the rest with the unforced one, so every
+/// node is updated once, in place. (Before, the region was collided into scratch ahead of an
+/// unforced sweep of the whole block and copied over its results: with the region's nodes
+/// swept twice and the copy, 9 % of a chapter 5 sphere's step, solver/bench/NOTES.md.)
 template <class L, class T, class Op>
 void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op,
-                              const field::VectorField<L::d, double>& force, const ForcedRegion& region,
-                              field::AlignedVector<T>& scratch) {
+                              const field::VectorField<L::d, double>& force, const ForcedRegion& region) {
   constexpr int Q = L::q, D = L::d;
-  const std::ptrdiff_t M = region.visited();
-  if (static_cast<std::ptrdiff_t>(scratch.size()) < Q * M) scratch.resize(static_cast<std::size_t>(Q * M));
-  const auto bases = pop.bases();
-  T* P[Q];
-  for (int i = 0; i < Q; ++i) P[i] = bases[i];
-  const double* fp[D];
+  const auto& g = pop.grid();
+  const std::array<T*, Q> P = pop.bases();
+  std::array<const double*, D> fp{};
   for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data();
-  T* out = scratch.data();
-  // The nodes are distinct, so no two lanes write one slot or one scratch entry.
-  auto forced = [=](std::ptrdiff_t n, std::ptrdiff_t k) __attribute__((always_inline)) {
-    T f[Q], F[D], post[Q];
-#pragma GCC unroll 19
-    for (int i = 0; i < Q; ++i) f[i] = P[i][n];
-    for (int a = 0; a < D; ++a) F[a] = T(fp[a][n]);
-    collide_forced<L, T>(f, F, op, post);
-#pragma GCC unroll 19
-    for (int i = 0; i < Q; ++i) out[i * M + k] = post[i];
-  };
-  for_each_forced_node<simd_chunk<T>>(region, forced);
-  sweep<false>(pop, op, nullptr);
-  auto put = [=](std::ptrdiff_t n, std::ptrdiff_t k) __attribute__((always_inline)) {
-#pragma GCC unroll 19
-    for (int i = 0; i < Q; ++i) P[L::opposite[i]][n] = out[i * M + k];
-  };
-  for_each_forced_node<simd_chunk<T>>(region, put);
+  const int nx = g.n()[0];
+  // The region's stretches [begin, end) in memory order: its spans, or its nodes one by one.
+  const bool spans = !region.spans.empty();
+  const std::ptrdiff_t count = spans ? static_cast<std::ptrdiff_t>(region.spans.size())
+                                     : static_cast<std::ptrdiff_t>(region.nodes.size());
+  auto begin_of = [&](std::ptrdiff_t k) { return spans ? region.spans[k].begin : region.nodes[k]; };
+  auto end_of = [&](std::ptrdiff_t k) { return spans ? region.spans[k].end : region.nodes[k] + 1; };
+
+  parallel_rows<D>(g, [&](std::ptrdiff_t base, const Index<D>&) {
+    T* P_l[Q];  // loop invariants in locals, as in sweep()
+    for (int i = 0; i < Q; ++i) P_l[i] = P[i];
+    const Op op_l = op;
+    const double* fp_l[D];
+    for (int a = 0; a < D; ++a) fp_l[a] = fp[a];
+    const std::ptrdiff_t row_end = base + nx;
+    std::ptrdiff_t lo = 0, hi = count;  // the first stretch at or after the row's start
+    while (lo < hi) {
+      const std::ptrdiff_t mid = (lo + hi) / 2;
+      if (begin_of(mid) < base)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    std::ptrdiff_t at = base;
+    for (std::ptrdiff_t k = lo; k < count && begin_of(k) < row_end; ++k) {
+      const std::ptrdiff_t b = begin_of(k), e = end_of(k);
+      update_stretch<false, L, T>(P_l, op_l, fp_l, at, static_cast<int>(b - at));
+      update_stretch<true, L, T>(P_l, op_l, fp_l, b, static_cast<int>(e - b));
+      at = e;
+    }
+    update_stretch<false, L, T>(P_l, op_l, fp_l, at, static_cast<int>(row_end - at));
+  });
   pop.flip_parity();
 }
 
@@ -352,7 +361,7 @@ void forced_velocity_at(const field::Populations<L, T>& pop, const field::Vector
   const double* fp[D];
   double* up[D];
   for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data(), up[a] = u.comp[a].data();
-  auto body = [=](std::ptrdiff_t n, std::ptrdiff_t) __attribute__((always_inline)) {
+  auto body = [=](std::ptrdiff_t n) __attribute__((always_inline)) {
     double f[Q], rho, v[D];
 #pragma GCC unroll 19
     for (int i = 0; i < Q; ++i) f[i] = P[i][n];

@@ -39,7 +39,6 @@ class Fluid {
     Op op;
     Force force;          // allocated when the block is ever forced
     bool has_body_force = false;
-    field::AlignedVector<T> forced_scratch;  // stream_collide_forced_at's results, grown as needed
     field::Box<D> skip;  // nodes its sweep leaves alone: the covered nodes of a coarse block
   };
 
@@ -151,7 +150,7 @@ class Fluid {
   }
 
  private:
-  static Block make_block(const field::Grid<D>& g, const Op& op) { return Block{Pop(g), op, Force(0), false, {}, {}}; }
+  static Block make_block(const field::Grid<D>& g, const Op& op) { return Block{Pop(g), op, Force(0), false, {}}; }
 
   /// One step of a block: forcing hook, then the boundaries' stage before the in-place sweep
   /// (what reads the state at time t), the sweep, and the stage that fills the entering slots.
@@ -170,7 +169,7 @@ class Fluid {
     if (blk.has_body_force)
       collision::stream_collide<true>(blk.pop, blk.op, &blk.force, blk.skip);
     else if (!forced.empty())
-      collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced, blk.forced_scratch);
+      collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced);
     else
       collision::stream_collide<false>(blk.pop, blk.op, nullptr, blk.skip);
     apply_boundaries();

@@ -390,12 +390,11 @@ void check_forced_collision_at_nodes(double density, bool spans) {
   }
   // Two steps, one from each parity of the in-place layout; the whole buffer is compared (the
   // slots entering from the ghost layer, which no boundary stage fills here, included).
-  field::AlignedVector<T> scratch;
   const double tol = std::is_same_v<T, float> ? 1e-7 : 1e-16;
   int mismatches = 0;
   for (int step = 0; step < 2; ++step) {
     stream_collide<true>(a, op, &force);
-    stream_collide_forced_at(b, op, force, region, scratch);
+    stream_collide_forced_at(b, op, force, region);
     ASSERT_EQ(a.parity(), b.parity());
     for (std::ptrdiff_t k = 0; k < Q * g.size(); ++k)
       if (std::abs(double(a.data()[k]) - double(b.data()[k])) > tol && ++mismatches <= 10)
@@ -437,11 +436,8 @@ TEST(CoverWithSpans, SpansAreDisjointRowStretchesOfWholeChunksThatCoverEveryNode
     EXPECT_GE(spans[k].end - spans[k].begin, W);
     if (k > 0) {
       EXPECT_GE(spans[k].begin, spans[k - 1].end);
-      // Dense numbering of the visited nodes, in order.
-      EXPECT_EQ(spans[k].first, spans[k - 1].first + (spans[k - 1].end - spans[k - 1].begin)) << "span " << k;
     }
   }
-  EXPECT_EQ(spans[0].first, 0);
   // Rows shorter than a chunk: no spans (the caller walks the node list).
   const field::Grid<3> narrow({W - 1, 4, 3}, Vec<3>::Zero(), 1.0);
   cover_with_spans<W>(narrow, std::vector<std::ptrdiff_t>{narrow.index({2, 1, 1})}, spans);
