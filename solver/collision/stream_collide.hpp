@@ -257,9 +257,10 @@ void cover_with_spans(const field::Grid<D>& g, std::span<const std::ptrdiff_t> n
   }
 }
 
-/// Runs body(n) for every node n of the spans (cover_with_spans<W>): each span as whole chunks of W consecutive nodes, one `omp simd` loop each, the last shifted
-/// back to end at the span's end (it redoes nodes, so body must write the same values each time
-/// and nothing another node reads); the spans in parallel (they are disjoint).
+/// Runs body(n) for every node n of the spans (cover_with_spans<W>): each span as whole chunks
+/// of W consecutive nodes, one `omp simd` loop each, the last shifted back to end at the span's
+/// end (it redoes nodes, so body must write the same values each time and nothing another node
+/// reads); the spans in parallel (they are disjoint).
 template <int W, class Body>
 [[gnu::always_inline]] inline void for_each_in_spans(std::span<const NodeSpan> spans, const Body& body) {
   const auto count = static_cast<std::ptrdiff_t>(spans.size());
