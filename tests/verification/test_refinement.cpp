@@ -311,6 +311,106 @@ TEST(TwoLevel, BandStepEqualsRestrictAndSweep3D) {
   band_step_equals_restrict_and_sweep<lattice::D3Q19, double>(collision::Trt{0.9, 0.25}, true);
 }
 
+// The fine sweep's row pad (TwoLevel::fine_row_pad: the ghost after each row's end updated as
+// if it were interior, so that rows of chunk − 1 nodes end on a whole vector chunk) changes no
+// value that anything reads: the fine interior and the uncovered coarse nodes stay bit for bit
+// those of the same steps without it, from a random state (ghost slots included), over coarse
+// steps that reach both parities of both blocks; unforced, with a uniform body force (the
+// Guo-forced sweep) and with a force on a few nodes only (stream_collide_forced_at).
+enum class FineForcing { none, body, region };
+template <class L, class T, class Op>
+void fine_row_pad_changes_nothing(Op op, FineForcing forcing) {
+  constexpr int D = L::d, Q = L::q, W = collision::simd_chunk<T>;
+  Index<D> n;
+  n.fill(W / 2 + 8);
+  auto [cg, fg] = two_blocks<D>(n, Vec<D>::Zero(), 4, 4 + W / 2);  // fine rows of W − 1 nodes
+  Op fine_op = op;
+  fine_op.tau = 0.5 + 2.0 * (op.tau - 0.5);
+  refinement::TwoLevel<L, T> tl(cg, fg, {op.tau, op.tau_minus()}, {fine_op.tau, fine_op.tau_minus()});
+  const int pad = tl.fine_row_pad(W);
+  ASSERT_EQ(pad, 1) << "the fine rows must have " << W - 1 << " nodes";
+  field::Populations<L, T> coarse(cg), fine(fg);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> small(-0.01, 0.01);
+  for (std::ptrdiff_t k = 0; k < Q * cg.size(); ++k) coarse.data()[k] = T(small(rng));
+  for (std::ptrdiff_t k = 0; k < Q * fg.size(); ++k) fine.data()[k] = T(small(rng));
+  field::VectorField<D, double> coarse_force(cg.size()), fine_force(fg.size());
+  std::vector<std::ptrdiff_t> nodes;
+  if (forcing == FineForcing::body) {
+    for (int a = 0; a < D; ++a) {
+      std::fill(coarse_force.comp[a].begin(), coarse_force.comp[a].end(), 2e-5 * (a + 1));
+      std::fill(fine_force.comp[a].begin(), fine_force.comp[a].end(), 1e-5 * (a + 1));
+    }
+  } else if (forcing == FineForcing::region) {
+    field::for_each_interior<D>(fg, [&](const Index<D>& x) {
+      if (small(rng) > 0.008) return;  // about one node in ten
+      nodes.push_back(fg.index(x));
+      for (int a = 0; a < D; ++a) fine_force.comp[a][nodes.back()] = small(rng) * 1e-2;
+    });
+  }
+  std::vector<collision::NodeSpan> spans;
+  collision::cover_with_spans<W>(fg, nodes, spans);
+  const collision::ForcedRegion region{nodes, spans};
+  T F[D];
+  for (int a = 0; a < D; ++a) F[a] = T(coarse_force.comp[a][0]);
+  const bool body = forcing == FineForcing::body;
+
+  auto padded_tl = tl;
+  auto padded_coarse = coarse, padded_fine = fine;
+  auto coarse_step = [&](refinement::TwoLevel<L, T>& c, field::Populations<L, T>& pc, field::Populations<L, T>& pf,
+                         int row_pad) {
+    if (body) {
+      c.template collide_band<true>(pc, pf, op, F);
+      collision::stream_collide<true>(pc, op, &coarse_force, c.idle_coarse());
+    } else {
+      c.template collide_band<false>(pc, pf, op, F);
+      collision::stream_collide<false>(pc, op, nullptr, c.idle_coarse());
+    }
+    c.capture_coarse(pc);
+    for (int sub = 0; sub < 2; ++sub) {
+      if (body)
+        collision::stream_collide<true>(pf, fine_op, &fine_force, {}, row_pad);
+      else if (forcing == FineForcing::region)
+        collision::stream_collide_forced_at(pf, fine_op, fine_force, region, row_pad);
+      else
+        collision::stream_collide<false>(pf, fine_op, nullptr, {}, row_pad);
+      c.fill_fine_ghosts(pf, fine_op, 0.5 * sub);
+    }
+  };
+  tl.capture_coarse(coarse);
+  padded_tl.capture_coarse(padded_coarse);
+  for (int step = 0; step < 3; ++step) {
+    coarse_step(tl, coarse, fine, 0);
+    coarse_step(padded_tl, padded_coarse, padded_fine, pad);
+    std::size_t compared = 0, differing = 0;
+    field::for_each_interior<D>(fg, [&](const Index<D>& x) {
+      for (int i = 0; i < Q; ++i, ++compared) differing += fine(i, fg.index(x)) != padded_fine(i, fg.index(x));
+    });
+    field::for_each_interior<D>(cg, [&](const Index<D>& x) {
+      if (tl.covered(x)) return;
+      for (int i = 0; i < Q; ++i, ++compared)
+        differing += coarse(i, cg.index(x)) != padded_coarse(i, cg.index(x));
+    });
+    EXPECT_GT(compared, 0U);
+    EXPECT_EQ(differing, 0U) << "coarse step " << step;
+  }
+  // The pad did run: some ghost slot of the fine block differs.
+  std::size_t ghost_slots_changed = 0;
+  for (std::ptrdiff_t k = 0; k < Q * fg.size(); ++k) ghost_slots_changed += fine.data()[k] != padded_fine.data()[k];
+  EXPECT_GT(ghost_slots_changed, 0U);
+}
+
+TEST(TwoLevel, FineRowPadChangesNothingRead2D) {
+  for (const auto forcing : {FineForcing::none, FineForcing::body, FineForcing::region})
+    fine_row_pad_changes_nothing<lattice::D2Q9, double>(collision::Bgk{0.8}, forcing);
+}
+TEST(TwoLevel, FineRowPadChangesNothingRead3D) {
+  for (const auto forcing : {FineForcing::none, FineForcing::body, FineForcing::region}) {
+    fine_row_pad_changes_nothing<lattice::D3Q19, double>(collision::Trt{0.9, 0.25}, forcing);
+    fine_row_pad_changes_nothing<lattice::D3Q19, float>(collision::Trt{0.9, 0.25}, forcing);
+  }
+}
+
 // The tests run on one OpenMP thread (tests/CMakeLists.txt); this one checks that the threaded
 // kernels, the two-level transfers included, give the same populations bit for bit.
 TEST(TwoLevel, PopulationsDoNotDependOnThreadCount) {
