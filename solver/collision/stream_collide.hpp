@@ -140,10 +140,6 @@ template <bool Forced, class L, class T, class Op>
 /// The in-place sweep of one time step over the interior of a block, without the parity flip
 /// (stream_collide and stream_collide_forced_at flip it). The nodes of `skip` are left alone
 /// (their slots keep their values; no other node reads or writes them, field/populations.hpp).
-/// `row_pad` (0 or 1) more nodes are updated past each row's end, in the ghost layer: only for
-/// a block whose ghosts' slots nothing reads but the stage that overwrites them after the sweep
-/// (refinement::TwoLevel::fine_row_pad), so that a row of n ≡ −1 (mod chunk) nodes ends on a
-/// whole vector chunk instead of pieces.
 ///
 /// Each row runs in chunks of simd_chunk<T> nodes with a trip count known at compile time, so
 /// the whole row is vector code, and the rest of the row in pieces of half, a quarter … of a
@@ -156,7 +152,7 @@ template <bool Forced, class L, class T, class Op>
 /// against 208 / 353 at 48^3; with the shifted chunk first, 87 / 59).
 template <bool Forced, class L, class T, class Op>
 void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>* force,
-           const field::Box<L::d>& skip = {}, int row_pad = 0) {
+           const field::Box<L::d>& skip = {}) {
   constexpr int Q = L::q, D = L::d;
   const auto& g = pop.grid();
   const std::array<T*, Q> P = pop.bases();
@@ -177,7 +173,7 @@ void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField
       update_run<Forced, L, T>(P_l, op_l, fp_l, base, skip.lo[0]);
       update_run<Forced, L, T>(P_l, op_l, fp_l, base + skip.hi[0], nx - skip.hi[0]);
     } else {
-      update_run<Forced, L, T>(P_l, op_l, fp_l, base, nx + row_pad);
+      update_run<Forced, L, T>(P_l, op_l, fp_l, base, nx);
     }
   });
 }
@@ -188,9 +184,8 @@ void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField
 /// `force` (lattice units, per node) must be non-null exactly when Forced is true.
 template <bool Forced, class L, class T, class Op>
 void stream_collide(field::Populations<L, T>& pop, const Op& op,
-                    const field::VectorField<L::d, double>* force = nullptr, const field::Box<L::d>& skip = {},
-                    int row_pad = 0) {
-  sweep<Forced>(pop, op, force, skip, row_pad);
+                    const field::VectorField<L::d, double>* force = nullptr, const field::Box<L::d>& skip = {}) {
+  sweep<Forced>(pop, op, force, skip);
   pop.flip_parity();
 }
 
@@ -311,11 +306,9 @@ template <bool Forced, class L, class T, class Op>
 /// node is updated once, in place. (Before, the region was collided into scratch ahead of an
 /// unforced sweep of the whole block and copied over its results: with the region's nodes
 /// swept twice and the copy, 9 % of a chapter 5 sphere's step, solver/bench/NOTES.md.)
-/// `row_pad` as in sweep().
 template <class L, class T, class Op>
 void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op,
-                              const field::VectorField<L::d, double>& force, const ForcedRegion& region,
-                              int row_pad = 0) {
+                              const field::VectorField<L::d, double>& force, const ForcedRegion& region) {
   constexpr int Q = L::q, D = L::d;
   const auto& g = pop.grid();
   const std::array<T*, Q> P = pop.bases();
@@ -351,7 +344,7 @@ void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op,
       update_stretch<true, L, T>(P_l, op_l, fp_l, b, static_cast<int>(e - b));
       at = e;
     }
-    update_stretch<false, L, T>(P_l, op_l, fp_l, at, static_cast<int>(row_end + row_pad - at));
+    update_stretch<false, L, T>(P_l, op_l, fp_l, at, static_cast<int>(row_end - at));
   });
   pop.flip_parity();
 }

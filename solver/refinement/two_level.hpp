@@ -215,16 +215,6 @@ class TwoLevel {
     return idle;
   }
 
-  /// Ghosts the fine sweep may update past each row's end (collision::sweep's row_pad) so that
-  /// its rows end on whole vector chunks of `chunk` nodes: 1 when the rows have n ≡ −1 (mod
-  /// chunk) nodes, else 0. Harmless because the fine block's ghost ring belongs to the coupling
-  /// alone: the slots a ghost writes are those that enter the interior, which fill_fine_ghosts
-  /// overwrites after the sweep, and those of other ghosts, which nothing reads (the band's
-  /// restriction reads interior fine nodes). The ghost at (n, y[, z]) of an interior row only
-  /// addresses slots inside the buffer. Rows of 47 (a chapter 5 sphere) or 127 nodes otherwise
-  /// end in three pieces of 4, 2 and 1 nodes (solver/bench/NOTES.md).
-  int fine_row_pad(int chunk) const { return fine_.n()[0] % chunk == chunk - 1 ? 1 : 0; }
-
   /// Whether a coarse node lies strictly inside the fine block (it is read through the fine grid).
   bool covered(const Index<D>& c) const {
     for (int a = 0; a < D; ++a)

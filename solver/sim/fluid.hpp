@@ -40,7 +40,6 @@ class Fluid {
     Force force;          // allocated when the block is ever forced
     bool has_body_force = false;
     field::Box<D> skip;  // nodes its sweep leaves alone: the covered nodes of a coarse block
-    int row_pad = 0;     // ghosts its sweep updates past each row (collision::sweep): a fine block
   };
 
   struct Setup {
@@ -63,7 +62,6 @@ class Fluid {
       coupling_ = refinement::TwoLevel<L, T>(s.coarse, *s.fine, {s.coarse_op.tau, s.coarse_op.tau_minus()},
                                              {fine_op.tau, fine_op.tau_minus()});
       blocks_[0].skip = coupling_.idle_coarse();
-      blocks_[1].row_pad = coupling_.fine_row_pad(collision::simd_chunk<T>);
     }
     coarse_bc_ = boundary::BoundarySet<L, T>(s.coarse, s.boundaries, s.imposed_velocity_lu, s.far_field);
     const bool body = s.body_force_lu.norm() > 0;
@@ -169,11 +167,11 @@ class Fluid {
     }
     before_sweep();
     if (blk.has_body_force)
-      collision::stream_collide<true>(blk.pop, blk.op, &blk.force, blk.skip, blk.row_pad);
+      collision::stream_collide<true>(blk.pop, blk.op, &blk.force, blk.skip);
     else if (!forced.empty())
-      collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced, blk.row_pad);
+      collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced);
     else
-      collision::stream_collide<false>(blk.pop, blk.op, nullptr, blk.skip, blk.row_pad);
+      collision::stream_collide<false>(blk.pop, blk.op, nullptr, blk.skip);
     apply_boundaries();
   }
 
