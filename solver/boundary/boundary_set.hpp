@@ -60,7 +60,7 @@ class BoundarySet {
     CAPLAB_CHECK(g.size() <= std::numeric_limits<int>::max(),
                  "block too large for the far field's 32-bit node indices");
     field::for_each_ghost<D>(g, [&](const Index<D>& h) { add_ghost(g, kinds, imposed, h); });
-    order_far_field();
+    order_far_field(g.n()[0]);
   }
 
   /// Before the sweep: the far-field ghosts' post-collision values from the state at time t
@@ -119,15 +119,23 @@ class BoundarySet {
     return face == mixed || L::c[i][face / 2] == (face % 2 == 0 ? 1 : -1);
   }
 
+  /// Whether face `face`'s ghosts are laid out in rows of consecutive interior nodes: beside
+  /// the faces normal to y or z, when the rows are at least a batch long (order_far_field).
+  bool in_rows(int face) const { return face != mixed && face / 2 != 0 && rows_of_batches_; }
+
   /// far_field_batch for batch b with the face of its ghosts as a compile-time constant.
   template <bool Equilibrium, int Face = 0, class Op>
   void batch_of_face(const std::array<const T*, Q>& current, const Op& op, std::ptrdiff_t b) {
-    if constexpr (Face == mixed)
-      far_field_batch<Equilibrium, Face>(current, op, b * batch);
-    else if (batch_face_[b] == Face)
-      far_field_batch<Equilibrium, Face>(current, op, b * batch);
-    else
+    if constexpr (Face == mixed) {
+      far_field_batch<Equilibrium, Face, false>(current, op, b * batch);
+    } else if (batch_face_[b] == Face) {
+      if (in_rows(Face))
+        far_field_batch<Equilibrium, Face, true>(current, op, b * batch);
+      else
+        far_field_batch<Equilibrium, Face, false>(current, op, b * batch);
+    } else {
       batch_of_face<Equilibrium, Face + 1>(current, op, b);
+    }
   }
 
   /// The post-collision state of ghosts k0 … k0 + batch − 1, all of face Face, into far_post_
@@ -138,9 +146,8 @@ class BoundarySet {
   /// compiler drops the arithmetic of the outputs not stored. Beside the faces normal to y or z
   /// the batch's interior nodes are consecutive (order_far_field) and read as vectors; beside x
   /// and in the mixed group they are gathered.
-  template <bool Equilibrium, int Face, class Op>
+  template <bool Equilibrium, int Face, bool contiguous, class Op>
   void far_field_batch(const std::array<const T*, Q>& current, const Op& op, std::ptrdiff_t k0) {
-    constexpr bool contiguous = Face != mixed && Face / 2 != 0;
     const std::ptrdiff_t K = static_cast<std::ptrdiff_t>(far_interior_.size());
     // What the loop reads through, in locals: through `this` or the array reference the
     // pointers are reloaded after every store.
@@ -236,12 +243,14 @@ class BoundarySet {
 
   /// Lays the staged far-field ghosts out in batches of one face each (face by face, the mixed
   /// group last), each face's ghosts in the order of the ghost layer. Beside the faces normal
-  /// to y or z each row's run is padded to whole batches, so that a batch reads consecutive
-  /// interior nodes. Padding ghosts own no links; a row's pads continue its interior nodes
-  /// (harmless reads of the row's ghost and the nodes after it), the others repeat the last
-  /// ghost. Then sizes the post-collision values (the constant far-field equilibrium: computed
-  /// now).
-  void order_far_field() {
+  /// to y or z, when the rows (along x) are at least a batch long, each row ends in a batch
+  /// shifted back to the row's last node, its first lanes padding ghosts over nodes of the
+  /// batch before: every batch reads consecutive interior nodes of one row (never past the
+  /// row, whose slots at the end of the block may lie past the buffer). Padding ghosts own no
+  /// links; elsewhere they repeat the face's last ghost to fill its last batch. Then sizes the
+  /// post-collision values (the constant far-field equilibrium: computed now).
+  void order_far_field(int row_length) {
+    rows_of_batches_ = row_length >= batch;
     std::vector<Link> links;
     Vec<D> last_u_b = Vec<D>::Zero();
     auto put = [&](int interior, const Vec<D>& u_b, int first, int last) {
@@ -251,19 +260,28 @@ class BoundarySet {
       far_first_link_.push_back(static_cast<int>(links.size()));
       links.insert(links.end(), far_links_.begin() + first, far_links_.begin() + last);
     };
-    auto pad = [&](int step) {
-      while (far_interior_.size() % batch != 0) put(far_interior_.back() + step, last_u_b, 0, 0);
+    std::vector<const Staged*> row;  // the ghosts of one row, in order
+    auto put_row = [&] {
+      const int n = static_cast<int>(row.size()), whole = n - n % batch;
+      for (int k = 0; k < whole; ++k) put(row[k]->interior, row[k]->u_b, row[k]->first, row[k]->last);
+      if (whole < n) {
+        for (int k = n - batch; k < whole; ++k) put(row[k]->interior, row[k]->u_b, 0, 0);  // padding
+        for (int k = whole; k < n; ++k) put(row[k]->interior, row[k]->u_b, row[k]->first, row[k]->last);
+      }
+      row.clear();
     };
     for (int face = 0; face <= mixed; ++face) {
-      const bool rows = face != mixed && face / 2 != 0;
-      int previous = -1;
       for (const Staged& gh : staged_) {
         if (gh.face != face) continue;
-        if (rows && previous >= 0 && gh.interior != previous + 1) pad(1);  // a new row
-        put(gh.interior, gh.u_b, gh.first, gh.last);
-        previous = gh.interior;
+        if (!in_rows(face)) {
+          put(gh.interior, gh.u_b, gh.first, gh.last);
+          continue;
+        }
+        if (!row.empty() && gh.interior != row.back()->interior + 1) put_row();
+        row.push_back(&gh);
       }
-      if (previous >= 0) pad(rows ? 1 : 0);
+      if (!row.empty()) put_row();
+      while (far_interior_.size() % batch != 0) put(far_interior_.back(), last_u_b, 0, 0);
       batch_face_.resize(far_interior_.size() / batch, static_cast<std::int8_t>(face));
     }
     far_first_link_.push_back(static_cast<int>(links.size()));
@@ -287,6 +305,7 @@ class BoundarySet {
   std::vector<int> far_first_link_;
   std::vector<Link> far_links_;
   std::vector<std::int8_t> batch_face_;  // the face of each batch's ghosts
+  bool rows_of_batches_ = false;          // rows at least a batch long (in_rows)
   // A far-field ghost as the constructor finds it (order_far_field lays them out).
   struct Staged {
     int interior;
