@@ -160,30 +160,19 @@ class TwoLevel {
   template <bool Forced, class Op>
   void collide_band(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine, const Op& op,
                     const T (&F)[D]) const {
-    const std::array<const T*, Q> src = fine.bases();
     const std::array<T*, Q> dst = coarse.bases();
-    const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(band_.coarse.size()) / batch;
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t bt = 0; bt < batches; ++bt) {
-      const std::ptrdiff_t k0 = bt * batch;
-      T post[Q][batch];
-#pragma omp simd
-      for (int b = 0; b < batch; ++b) {
-        T f[Q], feq[Q], out[Q];
-#pragma GCC unroll 19
-        for (int i = 0; i < Q; ++i) f[i] = src[i][band_.fine[k0 + b]];
-        rescale_non_equilibrium(f, feq, c_from_f_);
-        collision::collide_node<Forced, L, T>(f, F, op, out);  // as the sweep would
-#pragma GCC unroll 19
-        for (int i = 0; i < Q; ++i) post[i][b] = out[i];
-      }
+    auto collide = [=](const T(&f)[Q], T(&out)[Q]) __attribute__((always_inline)) {  // F, op copied
+      collision::collide_node<Forced, L, T>(f, F, op, out);  // as the sweep would
+    };
+    auto store = [&](std::ptrdiff_t k0, const T(&post)[Q][batch]) {
       for (int b = 0; b < batch; ++b) {
         const std::ptrdiff_t n = band_.coarse[k0 + b];
         const std::uint32_t leaving = band_.leaving[k0 + b];
         for (int i = 0; i < Q; ++i)
           if (leaving >> i & 1U) dst[L::opposite[i]][n] = post[i][b];
       }
-    }
+    };
+    for_each_restricted_batch(fine, band_, collide, store);
   }
 
   /// Sets every covered coarse node from the fine block. Nothing needs it (the coarse sweep
@@ -463,28 +452,51 @@ class TwoLevel {
     return pairs;
   }
 
-  /// Coarse nodes from their coincident fine nodes, vectorised over batches of nodes.
+  /// Coarse nodes from their coincident fine nodes.
   void restrict_nodes(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine,
                       const NodePairs& nodes) const {
-    const std::array<const T*, Q> src = fine.bases();
     const std::array<T*, Q> dst = coarse.bases();
+    auto keep = [](const T(&f)[Q], T(&out)[Q]) __attribute__((always_inline)) {
+#pragma GCC unroll 19
+      for (int i = 0; i < Q; ++i) out[i] = f[i];
+    };
+    auto store = [&](std::ptrdiff_t k0, const T(&out)[Q][batch]) {
+      for (int b = 0; b < batch; ++b)
+        for (int i = 0; i < Q; ++i) dst[i][nodes.coarse[k0 + b]] = out[i][b];
+    };
+    for_each_restricted_batch(fine, nodes, keep, store);
+  }
+
+  /// For each batch of `nodes`, in parallel: the fine populations of its fine nodes rescaled to
+  /// the coarse block (the restriction), through node(f, out) per node in one vector loop
+  /// (`node` marked always_inline and its loops unrolled, or GCC 12 leaves the loop scalar), then
+  /// store(k0, out) with out[i][b] for the batch's coarse nodes k0 + b (scattered stores,
+  /// outside the vector loop).
+  template <class Node, class Store>
+  void for_each_restricted_batch(const field::Populations<L, T>& fine, const NodePairs& nodes, const Node& node,
+                                 const Store& store) const {
+    const std::array<const T*, Q> bases = fine.bases();
+    const int* fine_node = nodes.fine.data();
     const std::ptrdiff_t batches = static_cast<std::ptrdiff_t>(nodes.coarse.size()) / batch;
 #pragma omp parallel for schedule(static)
     for (std::ptrdiff_t bt = 0; bt < batches; ++bt) {
       const std::ptrdiff_t k0 = bt * batch;
+      const T* src[Q];  // loop invariants in locals, as in collision::sweep
+      for (int i = 0; i < Q; ++i) src[i] = bases[i];
+      const Node node_l = node;
       T out[Q][batch];
 #pragma omp simd
       for (int b = 0; b < batch; ++b) {
-        T f[Q], feq[Q];
+        T f[Q], feq[Q], post[Q];
         // 32-bit node indices into each population's array: a vector gather (as the far field).
 #pragma GCC unroll 19
-        for (int i = 0; i < Q; ++i) f[i] = src[i][nodes.fine[k0 + b]];
+        for (int i = 0; i < Q; ++i) f[i] = src[i][fine_node[k0 + b]];
         rescale_non_equilibrium(f, feq, c_from_f_);
+        node_l(f, post);
 #pragma GCC unroll 19
-        for (int i = 0; i < Q; ++i) out[i][b] = f[i];
+        for (int i = 0; i < Q; ++i) out[i][b] = post[i];
       }
-      for (int b = 0; b < batch; ++b)
-        for (int i = 0; i < Q; ++i) dst[i][nodes.coarse[k0 + b]] = out[i][b];
+      store(k0, out);
     }
   }
 
