@@ -13,6 +13,8 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <span>
 #include <vector>
 
@@ -84,17 +86,36 @@ template <bool Forced, class L, class T, class Op>
   }
 }
 
+/// The velocity u + F/(2ρ) of a node's populations f under the force F, in double (thesis
+/// eq. 2.25: what the forced collision uses and the IB's markers move with), as up[a][n].
+template <class L, class T>
+[[gnu::always_inline]] inline void store_forced_velocity(const T (&f)[L::q], const double* const (&fp)[L::d],
+                                                         double* const* up, std::ptrdiff_t n) {
+  double fd[L::q], rho, j[L::d];
+#pragma GCC unroll 19
+  for (int i = 0; i < L::q; ++i) fd[i] = f[i];
+  density_momentum<L, double>(fd, rho, j);
+  const double inv_rho = 1.0 / rho;
+  // An explicit fma: GCC contracts j * inv_rho + ... or not depending on the code around it,
+  // and the sweep's velocity must equal forced_velocity_at's bit for bit.
+  for (int a = 0; a < L::d; ++a) up[a][n] = std::fma(j[a], inv_rho, fp[a][n] / (2.0 * rho));
+}
+
 /// Collide-and-push of node n in place (the body of the fused kernel's vector loop): reads
 /// f_i from P[i][n], writes the post-collision value i to P[ī][n] (field/populations.hpp: the
 /// same Q slots, and where the next step at the other parity finds it at node n + c_i).
-/// Scalars and references to C arrays only, so that GCC vectorizes the loop that calls it.
-template <bool Forced, class L, class T, class Op>
+/// With Velocity (forced only), also the node's velocity before the collision into up
+/// (store_forced_velocity). Scalars and references to C arrays only, so that GCC vectorizes
+/// the loop that calls it.
+template <bool Forced, class L, class T, bool Velocity = false, class Op>
 [[gnu::always_inline]] inline void update_node(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
-                                               std::ptrdiff_t n) {
+                                               std::ptrdiff_t n, double* const* up = nullptr) {
+  static_assert(Forced || !Velocity, "the velocity with the force is the forced kernel's");
   constexpr int Q = L::q, D = L::d;
   T f[Q], F[D], out[Q];
 #pragma GCC unroll 19
   for (int i = 0; i < Q; ++i) f[i] = P[i][n];
+  if constexpr (Velocity) store_forced_velocity<L, T>(f, fp, up, n);
   if constexpr (Forced)
     for (int a = 0; a < D; ++a) F[a] = T(fp[a][n]);
   collide_node<Forced, L, T>(f, F, op, out);
@@ -106,24 +127,24 @@ template <bool Forced, class L, class T, class Op>
 /// vector loop of a trip count known at compile time: the end of a row without overlapping
 /// chunks. Out of line and flattened: inlined into the row loop, GCC 12 ran out of inlining
 /// budget, called the collision out of line and left the pieces scalar.
-template <int w, bool Forced, class L, class T, class Op>
+template <int w, bool Forced, class L, class T, bool Velocity = false, class Op>
 [[gnu::noinline, gnu::flatten]] void update_pieces(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
-                                                 std::ptrdiff_t at, int rem) {
+                                                 std::ptrdiff_t at, int rem, double* const* up = nullptr) {
   if constexpr (w >= 1) {
     if (rem & w) {
 #pragma omp simd
-      for (int x = 0; x < w; ++x) update_node<Forced, L, T>(P, op, fp, at + x);
+      for (int x = 0; x < w; ++x) update_node<Forced, L, T, Velocity>(P, op, fp, at + x, up);
       at += w;
     }
-    update_pieces<w / 2, Forced, L, T>(P, op, fp, at, rem);
+    update_pieces<w / 2, Forced, L, T, Velocity>(P, op, fp, at, rem, up);
   }
 }
 
 /// Updates the n consecutive nodes from `at`: whole vector chunks, prefetching ahead, then the
 /// pieces of the rest.
-template <bool Forced, class L, class T, class Op>
+template <bool Forced, class L, class T, bool Velocity = false, class Op>
 [[gnu::always_inline]] inline void update_run(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
-                                              std::ptrdiff_t at, int n) {
+                                              std::ptrdiff_t at, int n, double* const* up = nullptr) {
   constexpr int W = simd_chunk<T>;
   const int whole = n - n % W;
   for (int x0 = 0; x0 < whole; x0 += W) {
@@ -132,9 +153,9 @@ template <bool Forced, class L, class T, class Op>
     // this thread takes next under the static schedule; past the array's end it is harmless.
     prefetch_node<L::q>(P, chunk + prefetch_lines * W);
 #pragma omp simd
-    for (int x = 0; x < W; ++x) update_node<Forced, L, T>(P, op, fp, chunk + x);
+    for (int x = 0; x < W; ++x) update_node<Forced, L, T, Velocity>(P, op, fp, chunk + x, up);
   }
-  update_pieces<W / 2, Forced, L, T>(P, op, fp, at + whole, n - whole);
+  update_pieces<W / 2, Forced, L, T, Velocity>(P, op, fp, at + whole, n - whole, up);
 }
 
 /// The in-place sweep of one time step over the interior of a block, without the parity flip
@@ -222,10 +243,14 @@ struct NodeSpan {
 
 /// The nodes a forcing stage visits: distinct interior nodes in memory order and, where the
 /// block's rows are at least a vector chunk long, the spans that cover them (cover_with_spans).
+/// `velocity`, when set (a block-sized field per component, D of them), asks the forced
+/// collision for u + F/(2ρ) at the nodes it visits (store_forced_velocity; stale elsewhere).
 struct ForcedRegion {
   std::span<const std::ptrdiff_t> nodes;
   std::span<const NodeSpan> spans;
+  std::array<double*, 3> velocity{};
   bool empty() const { return nodes.empty(); }
+  bool wants_velocity() const { return velocity[0] != nullptr; }
 };
 
 /// Covers the sorted distinct interior nodes `nodes` of grid g with spans of at least W nodes,
@@ -291,15 +316,19 @@ template <int W, class Body>
 /// update_run as a call (noinline, flattened): a row cut into stretches calls it several times,
 /// and inlined so often into the row loop GCC 12 would run out of inlining budget and leave the
 /// collision out of line (see update_pieces).
-template <bool Forced, class L, class T, class Op>
+template <bool Forced, class L, class T, bool Velocity = false, class Op>
 [[gnu::noinline, gnu::flatten]] void update_stretch(T* const (&P)[L::q], const Op& op,
-                                                  const double* const (&fp)[L::d], std::ptrdiff_t at, int n) {
-  update_run<Forced, L, T>(P, op, fp, at, n);
+                                                  const double* const (&fp)[L::d], std::ptrdiff_t at, int n,
+                                                  double* const* up = nullptr) {
+  update_run<Forced, L, T, Velocity>(P, op, fp, at, n, up);
 }
 
 /// One time step of a block with Guo forcing at the nodes of `region` only (the force must be
 /// zero off region.nodes; the nodes between them that its spans visit take the forced update
-/// with zero force: the unforced one up to round-off), then the parity flip. This keeps the
+/// with zero force: the unforced one up to round-off), then the parity flip. Where the region
+/// asks for it, the forced stretches also write the velocity before the collision
+/// (region.velocity: what forced_velocity_at would give, without a pass of its own over the
+/// populations, measured 4 % of a chapter 5 sphere's samples, solver/bench/NOTES.md). This keeps the
 /// forced kernel, about twice the cost per node, to the IB's stencils. One sweep: each row runs
 /// the region's stretches in it (its spans, or its listed nodes one by one where the rows are
 /// too short for spans) with the forced kernel and the rest with the unforced one, so every
@@ -321,13 +350,15 @@ void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op,
                                      : static_cast<std::ptrdiff_t>(region.nodes.size());
   auto begin_of = [&](std::ptrdiff_t k) { return spans ? region.spans[k].begin : region.nodes[k]; };
   auto end_of = [&](std::ptrdiff_t k) { return spans ? region.spans[k].end : region.nodes[k] + 1; };
+  const bool velocity = region.wants_velocity();
 
   parallel_rows<D>(g, [&](std::ptrdiff_t base, const Index<D>&) {
     T* P_l[Q];  // loop invariants in locals, as in sweep()
     for (int i = 0; i < Q; ++i) P_l[i] = P[i];
     const Op op_l = op;
     const double* fp_l[D];
-    for (int a = 0; a < D; ++a) fp_l[a] = fp[a];
+    double* up_l[D];
+    for (int a = 0; a < D; ++a) fp_l[a] = fp[a], up_l[a] = region.velocity[a];
     const std::ptrdiff_t row_end = base + nx;
     std::ptrdiff_t lo = 0, hi = count;  // the first stretch at or after the row's start
     while (lo < hi) {
@@ -341,7 +372,10 @@ void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op,
     for (std::ptrdiff_t k = lo; k < count && begin_of(k) < row_end; ++k) {
       const std::ptrdiff_t b = begin_of(k), e = end_of(k);
       update_stretch<false, L, T>(P_l, op_l, fp_l, at, static_cast<int>(b - at));
-      update_stretch<true, L, T>(P_l, op_l, fp_l, b, static_cast<int>(e - b));
+      if (velocity)
+        update_stretch<true, L, T, true>(P_l, op_l, fp_l, b, static_cast<int>(e - b), up_l);
+      else
+        update_stretch<true, L, T>(P_l, op_l, fp_l, b, static_cast<int>(e - b));
       at = e;
     }
     update_stretch<false, L, T>(P_l, op_l, fp_l, at, static_cast<int>(row_end - at));
@@ -349,25 +383,25 @@ void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op,
   pop.flip_parity();
 }
 
-/// u + F/(2ρ) into `u` at the nodes of `region` (same linear indices; the nodes between them
-/// that its spans visit too): the velocity of the forced collision (thesis eq. 2.25), which
-/// the markers move with. In double, as node_moments; vector code as collide_forced_at.
+/// u + F/(2ρ) into region.velocity at the nodes of `region` (same linear indices; the nodes
+/// between them that its spans visit too), from the populations before the sweep: what
+/// stream_collide_forced_at writes there, for a block that takes the forced kernel everywhere
+/// (a uniform body force) and so never runs it.
 template <class L, class T>
 void forced_velocity_at(const field::Populations<L, T>& pop, const field::VectorField<L::d, double>& force,
-                        const ForcedRegion& region, field::VectorField<L::d, double>& u) {
+                        const ForcedRegion& region) {
   constexpr int Q = L::q, D = L::d;
   const auto bases = pop.bases();
   const T* P[Q];
   for (int i = 0; i < Q; ++i) P[i] = bases[i];
   const double* fp[D];
   double* up[D];
-  for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data(), up[a] = u.comp[a].data();
+  for (int a = 0; a < D; ++a) fp[a] = force.comp[a].data(), up[a] = region.velocity[a];
   auto body = [=](std::ptrdiff_t n) __attribute__((always_inline)) {
-    double f[Q], rho, v[D];
+    T f[Q];
 #pragma GCC unroll 19
     for (int i = 0; i < Q; ++i) f[i] = P[i][n];
-    moments<L, double>(f, rho, v);
-    for (int a = 0; a < D; ++a) up[a][n] = v[a] + fp[a][n] / (2.0 * rho);
+    store_forced_velocity<L, T>(f, fp, up, n);
   };
   for_each_forced_node<simd_chunk<T>>(region, body);
 }

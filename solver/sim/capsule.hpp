@@ -9,7 +9,9 @@
 //      of the velocity the Guo-forced collision uses, eq. 2.25);
 //   4. X(t + dt) = X(t) + U_m dt                           (no slip, eq. 2.15; explicit Euler,
 //      first order in time, the scheme of the thesis).
-// Step 3 runs after every body has spread its force, so U sees the whole force field.
+// Step 3 runs after every body has spread its force, so U sees the whole force field: the
+// forced collision of the sweep writes u* + f / (2 rho) at the stencils' nodes (from the
+// populations before it collides them), and steps 3 and 4 follow the sweep (Scene::advect_capsules).
 // The membrane is massless: the force it exerts on the fluid is the whole story (Newton's
 // third law), and there is no internal-mass correction.
 //

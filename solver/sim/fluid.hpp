@@ -31,7 +31,8 @@ class Fluid {
   /// body force everywhere except at the nodes the hook changed in its previous call, which
   /// the hook restores first: the IB touches only its stencils, so nothing here sweeps the
   /// whole field every substep. Without a uniform body force only the returned region takes
-  /// the forced kernel (stream_collide_forced_at); with one, the whole block does.
+  /// the forced kernel (stream_collide_forced_at); with one, the whole block does. A region
+  /// that asks for the velocity (ForcedRegion::velocity) finds it written after the sweep.
   using ForcingHook = std::function<collision::ForcedRegion(const Pop&, Force&)>;
 
   struct Block {
@@ -87,13 +88,16 @@ class Fluid {
     if (two_level()) coupling_.capture_coarse(blocks_[0].pop);
   }
 
-  /// One coarse time step (and m = 2 fine substeps). `hook` forces the finest block.
-  void step(const ForcingHook& hook = {}) {
+  /// One coarse time step (and m = 2 fine substeps). `hook` forces the finest block;
+  /// `swept` runs after each sweep of it (when the hook's region asked for the velocity, it is
+  /// there then).
+  void step(const ForcingHook& hook = {}, const std::function<void()>& swept = {}) {
     auto& c = blocks_[0];
     auto coarse_before = [&] { coarse_bc_.prepare(c.pop, c.op); };
     auto coarse_after = [&] { coarse_bc_.apply(c.pop); };
     if (!two_level()) {
       advance_block(c, hook, coarse_before, coarse_after);
+      if (swept) swept();
       return;
     }
     auto& f = blocks_[1];
@@ -110,10 +114,12 @@ class Fluid {
     };
     advance_block(c, {}, coarse_and_band_before, coarse_after);
     core::timed(coupling_seconds_, [&] { coupling_.capture_coarse(c.pop); });
-    for (int sub = 0; sub < 2; ++sub)
+    for (int sub = 0; sub < 2; ++sub) {
       advance_block(f, hook, [] {}, [&] {
         core::timed(coupling_seconds_, [&] { coupling_.fill_fine_ghosts(f.pop, f.op, 0.5 * sub); });
       });
+      if (swept) swept();
+    }
   }
 
   /// The evolving state (io/checkpoint.hpp archive): populations of every block and the coarse
@@ -166,8 +172,10 @@ class Fluid {
       forced = hook(blk.pop, blk.force);
     }
     before_sweep();
-    if (blk.has_body_force)
+    if (blk.has_body_force) {
+      if (forced.wants_velocity()) collision::forced_velocity_at(blk.pop, blk.force, forced);
       collision::stream_collide<true>(blk.pop, blk.op, &blk.force, blk.skip);
+    }
     else if (!forced.empty())
       collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced);
     else

@@ -8,7 +8,8 @@
 // velocity) followed by the forced collide-push and the coupled ghost ring; restriction.
 // Forces on bodies: minus the force they spread (Newton's third law); fixed bodies need no
 // internal-mass correction. Capsules (sim/capsule.hpp) spread their membrane force after the
-// rigid bodies and then move with the velocity of the whole force field.
+// rigid bodies and then move with the velocity of the whole force field, which the forced
+// collide-push writes at their stencils' nodes (Scene::advect_capsules runs after it).
 #pragma once
 
 #include <algorithm>
@@ -151,11 +152,12 @@ class Scene {
     auto last_checkpoint = clock::now();
     auto last_report = clock::now();
     auto hook = [&](const typename FluidT::Pop& pop, typename FluidT::Force& f) { return apply_ib(pop, f); };
+    auto swept = [&] { advect_capsules(); };
     std::vector<double> row(width);
     try {
       for (long step = step_ + 1; step <= total; ++step) {
         step_ = step;
-        core::timed(seconds_fluid_, [&] { fluid_.step(hook); });
+        core::timed(seconds_fluid_, [&] { fluid_.step(hook, swept); });
         const double t = step * dt;
         if (!capsules_.empty()) core::timed(seconds_diagnostics_, [&] { track_capsules(); });
         const bool checkpoint_due =
@@ -482,12 +484,25 @@ class Scene {
     if (bodies_.empty() && capsules_.empty()) return {};
     core::timed(seconds_ib_, [&] { restore_forced_nodes(f); });
     if (!bodies_.empty()) core::timed(seconds_ib_, [&] { force_bodies(pop, f); });
-    if (!capsules_.empty()) move_capsules(pop, f);
+    if (!capsules_.empty()) spread_capsules(pop, f);
     core::timed(seconds_ib_, [&] {
-      if (capsules_.empty()) collect_forced_nodes(pop.grid());  // move_capsules collected them
+      if (capsules_.empty()) collect_forced_nodes(pop.grid());  // spread_capsules collected them
     });
     ++fine_steps_;
-    return forced_region();
+    collision::ForcedRegion region = forced_region();
+    if (!capsules_.empty())  // for the markers' move after the sweep (advect_capsules)
+      for (int a = 0; a < D; ++a) region.velocity[a] = forced_velocity_.comp[a].data();
+    return region;
+  }
+
+  /// After the sweep of the finest block: the markers move with the velocity the forced
+  /// collision found at their stencils' nodes (capsule.hpp, steps 3 and 4).
+  void advect_capsules() {
+    if (capsules_.empty()) return;
+    core::timed(seconds_ib_, [&] {
+      const double dx = fluid_.finest().pop.grid().dx();
+      for (auto& c : capsules_) c.advect(forced_velocity_, dx);
+    });
   }
 
   /// Sets the nodes the IB wrote last step (forced_nodes_, each once) back to the uniform body
@@ -517,21 +532,19 @@ class Scene {
   }
   collision::ForcedRegion forced_region() const { return {forced_nodes_, forced_spans_}; }
 
-  /// Membrane forces, spreading, and the markers' move with the forced velocity (capsule.hpp).
-  void move_capsules(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
+  /// Membrane forces and spreading (capsule.hpp, steps 1 and 2); the forced collision then finds
+  /// the velocity at the stencils' nodes and advect_capsules moves the markers.
+  void spread_capsules(const typename FluidT::Pop& pop, typename FluidT::Force& f) {
     core::timed(seconds_membrane_, [&] {
       for (auto& c : capsules_) c.compute_forces();
     });
     core::timed(seconds_ib_, [&] {
       for (auto& c : capsules_) guarded(c, [&] { c.spread(pop.grid(), periodic_, f); });
-      // The velocity the forced collision uses, once per stencil node (stencils overlap).
       collect_forced_nodes(pop.grid());
-      // Written into a block-sized field (only at the stencil nodes, which are all the
-      // interpolation reads), so that the interpolation reads rows of consecutive nodes.
+      // The velocity goes into a block-sized field (only at the stencil nodes, which are all
+      // the interpolation reads), so that the interpolation reads rows of consecutive nodes.
       if (static_cast<std::ptrdiff_t>(forced_velocity_.comp[0].size()) != pop.grid().size())
         forced_velocity_ = field::VectorField<D>(pop.grid().size());
-      collision::forced_velocity_at<L, T>(pop, f, forced_region(), forced_velocity_);
-      for (auto& c : capsules_) c.advect(forced_velocity_, pop.grid().dx());
     });
   }
 
