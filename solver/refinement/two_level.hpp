@@ -144,7 +144,8 @@ class TwoLevel {
                 coarse_f[i][b] = midpoint(r0[b], r0[row + b], r0[2 * row + b], r0[3 * row + b]);
             }
           }
-          collide_ghosts(coarse_f, P, op_fine, fc.first_ghost + static_cast<std::ptrdiff_t>(fv) * row + b0);
+          collide_ghosts_of(ch.face, coarse_f, P, op_fine, fc.first_ghost + static_cast<std::ptrdiff_t>(fv) * row + b0,
+                            std::make_integer_sequence<int, 2 * D>());
         }
       }
     }
@@ -215,9 +216,23 @@ class TwoLevel {
   /// Nodes per vector loop (collide_ghosts, restrict_nodes): one 64-byte cache line of T.
   static constexpr int batch = static_cast<int>(64 / sizeof(T));
 
-  /// Ghosts k0 … k0 + batch − 1 from their interpolated coarse populations: rescaled to the
-  /// fine block, collided with the fine operator, then pushed along their links.
-  template <class Op>
+  /// Whether population i enters the fine interior from a ghost of face `face` (2 a + side:
+  /// the ghosts at fine index −1, side 0, or n, side 1, along axis a).
+  static constexpr bool enters_from(int face, int i) { return L::c[i][face / 2] == (face % 2 == 0 ? 1 : -1); }
+
+  /// collide_ghosts with the face as a compile-time constant.
+  template <class Op, int... Faces>
+  void collide_ghosts_of(int face, const T (&coarse_f)[Q][batch], const std::array<T*, Q>& P, const Op& op,
+                         std::ptrdiff_t k0, std::integer_sequence<int, Faces...>) const {
+    ((face == Faces ? collide_ghosts<Faces>(coarse_f, P, op, k0) : void()), ...);
+  }
+
+  /// Ghosts k0 … k0 + batch − 1 of face Face from their interpolated coarse populations:
+  /// rescaled to the fine block, collided with the fine operator, then pushed along their
+  /// links. Only the populations that enter the interior from the face are kept (5 of 19 in
+  /// D3Q19; every link of a ghost of the face is one of them): the compiler drops the rest of
+  /// the rescaling and collision, as in the far field (boundary/boundary_set.hpp).
+  template <int Face, class Op>
   void collide_ghosts(const T (&coarse_f)[Q][batch], const std::array<T*, Q>& P, const Op& op,
                       std::ptrdiff_t k0) const {
     T post[Q][batch];
@@ -229,7 +244,8 @@ class TwoLevel {
       rescale_non_equilibrium(f, feq, f_from_c_);
       op.template collide<L, T>(f, feq, out);
 #pragma GCC unroll 19
-      for (int i = 0; i < Q; ++i) post[i][b] = out[i];
+      for (int i = 0; i < Q; ++i)
+        if (enters_from(Face, i)) post[i][b] = out[i];
     }
     for (int b = 0; b < batch; ++b) {
       const auto& gh = ghosts_[k0 + b];
@@ -398,7 +414,11 @@ class TwoLevel {
               for (int i = 0; i < Q; ++i) {
                 Index<D> t;
                 for (int d = 0; d < D; ++d) t[d] = g[d] + L::c[i][d];
-                if (fine_.is_interior(t)) links_.push_back({i, fine_.index(t)});
+                if (!fine_.is_interior(t)) continue;
+                // collide_ghosts keeps only these populations (a ghost outside the interior
+                // along a reaches it only with c_a pointing inwards).
+                CAPLAB_CHECK(enters_from(2 * a + side, i), "two-level coupling: a ghost link leaves its face");
+                links_.push_back({i, fine_.index(t)});
               }
             }
             // Padding (fu beyond the face) has no link.
