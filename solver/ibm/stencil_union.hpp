@@ -1,6 +1,7 @@
 // The union of the immersed-boundary stencils of a step: each node once, in memory order.
 //
-// The forced collision and the velocity gather run on the nodes that some stencil touches.
+// The forced collision (with the velocity the capsules move with) runs on the nodes that some
+// stencil touches.
 // Stencils overlap heavily (a 3D capsule of 4098 markers has 262k stencil entries, many times
 // its distinct nodes), so the union is marked in byte masks over the block and read back over
 // the range the stencils span (a sort of the entries cost as much as spreading).

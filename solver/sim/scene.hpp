@@ -517,9 +517,9 @@ class Scene {
 
   /// forced_nodes_ = the union of the current stencils of all bodies and capsules, each node
   /// once and in memory order (ibm::StencilUnion), and forced_spans_ the row spans that cover
-  /// it (collision::cover_with_spans), which the forced collision and velocity walk.
-  /// Memory order lets the forced collision and the velocity gather walk the block's rows
-  /// instead of jumping between the rows of each stencil (measured: unsorted, the forced
+  /// it (collision::cover_with_spans), which the forced collision (and the velocity it writes
+  /// for the capsules) walks. Memory order lets it walk the block's rows instead of jumping
+  /// between the rows of each stencil (measured: unsorted, the forced
   /// collision of a 3D capsule's ~10k stencil nodes cost five unforced updates per node).
   void collect_forced_nodes(const field::Grid<D>& grid) {
     stencil_union_.begin(grid.size());
