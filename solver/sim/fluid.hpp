@@ -175,11 +175,11 @@ class Fluid {
     if (blk.has_body_force) {
       if (forced.wants_velocity()) collision::forced_velocity_at(blk.pop, blk.force, forced);
       collision::stream_collide<true>(blk.pop, blk.op, &blk.force, blk.skip);
-    }
-    else if (!forced.empty())
+    } else if (!forced.empty()) {
       collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced);
-    else
+    } else {
       collision::stream_collide<false>(blk.pop, blk.op, nullptr, blk.skip);
+    }
     apply_boundaries();
   }
 
