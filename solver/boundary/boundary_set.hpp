@@ -37,6 +37,7 @@
 #include "collision/equilibrium.hpp"
 #include "core/error.hpp"
 #include "field/populations.hpp"
+#include "lattice/lattice.hpp"
 
 namespace caplab::boundary {
 
@@ -116,7 +117,7 @@ class BoundarySet {
   static constexpr int mixed = 2 * D;
   /// Whether population i enters the interior from a ghost of face `face` (all do for mixed).
   static constexpr bool enters_from(int face, int i) {
-    return face == mixed || L::c[i][face / 2] == (face % 2 == 0 ? 1 : -1);
+    return face == mixed || lattice::enters_through_face<L>(face, i);
   }
 
   /// Whether face `face`'s ghosts are laid out in rows of consecutive interior nodes: beside

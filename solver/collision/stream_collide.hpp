@@ -325,14 +325,14 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
 
 /// One time step of a block with Guo forcing at the nodes of `region` only (the force must be
 /// zero off region.nodes; the nodes between them that its spans visit take the forced update
-/// with zero force: the unforced one up to round-off), then the parity flip. Where the region
-/// asks for it, the forced stretches also write the velocity before the collision
-/// (region.velocity: what forced_velocity_at would give, without a pass of its own over the
-/// populations, which was 4 % of a chapter 5 sphere's samples, solver/bench/NOTES.md). This
-/// keeps the forced kernel, about twice the cost per node, to the IB's stencils. One sweep: each row runs
+/// with zero force: the unforced one up to round-off), then the parity flip. This keeps the
+/// forced kernel, about twice the cost per node, to the IB's stencils. One sweep: each row runs
 /// the region's stretches in it (its spans, or its listed nodes one by one where the rows are
 /// too short for spans) with the forced kernel and the rest with the unforced one, so every
-/// node is updated once, in place. (Before, the region was collided into scratch ahead of an
+/// node is updated once, in place. Where the region asks for it, the forced stretches also
+/// write the velocity before the collision (region.velocity: what forced_velocity_at would
+/// give, without its pass over the populations, which was 4 % of a chapter 5 sphere's
+/// samples, solver/bench/NOTES.md). (Before, the region was collided into scratch ahead of an
 /// unforced sweep of the whole block and copied over its results: with the region's nodes
 /// swept twice and the copy, 9 % of a chapter 5 sphere's step, solver/bench/NOTES.md.)
 template <class L, class T, class Op>

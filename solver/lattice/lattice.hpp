@@ -71,6 +71,15 @@ struct D3Q19 {
   static constexpr std::array<int, 19> opposite = detail::opposites<3, 19>(c);
 };
 
+/// Whether population i of lattice L enters a block's interior from a ghost of face `face`:
+/// face 2a + s lies beyond the interior along axis a, on the low (s = 0) or high (s = 1) side,
+/// so its ghosts reach the interior only along c_a = +1 or −1. The one face convention of the
+/// boundaries (boundary/boundary_set.hpp) and the two-level coupling (refinement/two_level.hpp).
+template <class L>
+constexpr bool enters_through_face(int face, int i) {
+  return L::c[i][face / 2] == (face % 2 == 0 ? 1 : -1);
+}
+
 /// The lattice of a dimension: D2Q9 in 2D, D3Q19 in 3D.
 template <int D>
 struct LatticeOf;

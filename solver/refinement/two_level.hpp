@@ -52,6 +52,7 @@
 #include "collision/stream_collide.hpp"
 #include "core/error.hpp"
 #include "field/populations.hpp"
+#include "lattice/lattice.hpp"
 
 namespace caplab::refinement {
 
@@ -216,10 +217,6 @@ class TwoLevel {
   /// Nodes per vector loop (collide_ghosts, restrict_nodes): one 64-byte cache line of T.
   static constexpr int batch = static_cast<int>(64 / sizeof(T));
 
-  /// Whether population i enters the fine interior from a ghost of face `face` (2 a + side:
-  /// the ghosts at fine index −1, side 0, or n, side 1, along axis a).
-  static constexpr bool enters_from(int face, int i) { return L::c[i][face / 2] == (face % 2 == 0 ? 1 : -1); }
-
   /// collide_ghosts with the face as a compile-time constant.
   template <class Op, int... Faces>
   void collide_ghosts_of(int face, const T (&coarse_f)[Q][batch], const std::array<T*, Q>& P, const Op& op,
@@ -245,7 +242,7 @@ class TwoLevel {
       op.template collide<L, T>(f, feq, out);
 #pragma GCC unroll 19
       for (int i = 0; i < Q; ++i)
-        if (enters_from(Face, i)) post[i][b] = out[i];
+        if (lattice::enters_through_face<L>(Face, i)) post[i][b] = out[i];
     }
     for (int b = 0; b < batch; ++b) {
       const auto& gh = ghosts_[k0 + b];
@@ -417,7 +414,8 @@ class TwoLevel {
                 if (!fine_.is_interior(t)) continue;
                 // collide_ghosts keeps only these populations (a ghost outside the interior
                 // along a reaches it only with c_a pointing inwards).
-                CAPLAB_CHECK(enters_from(2 * a + side, i), "two-level coupling: a ghost link leaves its face");
+                CAPLAB_CHECK(lattice::enters_through_face<L>(2 * a + side, i),
+                             "two-level coupling: a ghost link leaves its face");
                 links_.push_back({i, fine_.index(t)});
               }
             }

@@ -519,8 +519,8 @@ class Scene {
   /// once and in memory order (ibm::StencilUnion), and forced_spans_ the row spans that cover
   /// it (collision::cover_with_spans), which the forced collision (and the velocity it writes
   /// for the capsules) walks. Memory order lets it walk the block's rows instead of jumping
-  /// between the rows of each stencil (measured: unsorted, the forced
-  /// collision of a 3D capsule's ~10k stencil nodes cost five unforced updates per node).
+  /// between the rows of each stencil (measured: unsorted, the forced collision of a 3D
+  /// capsule's ~10k stencil nodes cost five unforced updates per node).
   void collect_forced_nodes(const field::Grid<D>& grid) {
     stencil_union_.begin(grid.size());
     for (const auto& b : bodies_)

@@ -56,5 +56,26 @@ TYPED_TEST(LatticeTest, IsotropyUpToFourthOrder) {
   }
 }
 
+TYPED_TEST(LatticeTest, EnteringThroughAFaceIsPointingInwardsAlongItsAxis) {
+  // Face 2a + s: a ghost at -1 (s = 0) or n (s = 1) along axis a and inside along the others
+  // reaches the interior exactly along the directions with c_a = +1 or -1: 3 of 9 in D2Q9,
+  // 5 of 19 in D3Q19 (what the far field and the two-level ghosts keep of their collision).
+  using L = TypeParam;
+  constexpr int n = 3;  // a box of 3 nodes per axis; the ghost in the middle of a face
+  for (int face = 0; face < 2 * L::d; ++face) {
+    int count = 0;
+    for (int i = 0; i < L::q; ++i) {
+      bool inside = true;
+      for (int b = 0; b < L::d; ++b) {
+        const int ghost = b != face / 2 ? 1 : face % 2 == 0 ? -1 : n;
+        inside = inside && ghost + L::c[i][b] >= 0 && ghost + L::c[i][b] < n;
+      }
+      EXPECT_EQ(enters_through_face<L>(face, i), inside) << "face " << face << ", i " << i;
+      count += enters_through_face<L>(face, i);
+    }
+    EXPECT_EQ(count, L::d == 2 ? 3 : 5) << "face " << face;
+  }
+}
+
 }  // namespace
 }  // namespace caplab::lattice
