@@ -10,6 +10,7 @@
 #include "case/load_case.hpp"
 #include "collision/operators.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "sim/run_case.hpp"
 #include "sim/units.hpp"
 
@@ -95,6 +96,7 @@ int list(const fs::path& dir) {
 }
 
 int run(const RunArgs& args, bool terminal) {
+  core::install_stop_handlers();  // Ctrl-C or SIGTERM: checkpoint and stop (core/interrupt.hpp)
   sim::ProgressFn progress = [&](long step, long total, double t, double mlups, double eta) {
     const std::string line =
         fmt::format("step {}/{}  t = {:.2f} L/U  {:.1f} MLUPS  ETA {}", step, total, t, mlups, human_seconds(eta));

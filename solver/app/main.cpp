@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include "app/commands.hpp"
 #include "core/build_info.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 
 namespace fs = std::filesystem;
 using namespace caplab;
@@ -27,7 +29,9 @@ int main(int argc, char** argv) {
                                         std::string(core::build_info().git_sha) + ")");
 
   app::RunArgs run;
-  auto* run_cmd = app.add_subcommand("run", "Run a case and write its run directory (then score it)");
+  auto* run_cmd = app.add_subcommand("run",
+                                     "Run a case and write its run directory (then score it). Ctrl-C or SIGTERM ends "
+                                     "the current step, writes checkpoint.h5 and stops (continue with --resume)");
   auto* run_case = run_cmd->add_option("case", run.case_file, "Case file (JSON)")->check(CLI::ExistingFile);
   auto* resume = run_cmd->add_option("--resume", run.resume,
                                      "Continue the interrupted run in this run directory from its checkpoint.h5 "
@@ -120,6 +124,14 @@ int main(int argc, char** argv) {
   } catch (const core::NumericalError& e) {
     fmt::print(stderr, "caplab: {}\n", e.what());
     return 3;
+  } catch (const core::Interrupted& e) {
+    // Stopped on request with its checkpoint written: end by the same signal (its default
+    // action), so that the shell or batch system that sent it sees the process stopped by it.
+    fmt::print(stderr, "\ncaplab: {}\n", e.what());
+    std::fflush(nullptr);
+    std::signal(e.signal(), SIG_DFL);
+    std::raise(e.signal());
+    return 128 + e.signal();
   } catch (const std::exception& e) {
     fmt::print(stderr, "caplab: error: {}\n", e.what());
     // An HDF5 file whose close failed (a full disk) makes the HDF5 library's exit handler crash

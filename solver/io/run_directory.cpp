@@ -174,8 +174,8 @@ RunDirectory RunDirectory::resume(const fs::path& dir) {
   run.manifest_["status"] = "running";
   nlohmann::json entry = {{"at_utc", utc_now_iso8601()}, {"status_before", status}};
   if (run.manifest_.contains("error")) entry["error_before"] = run.manifest_["error"];
-  run.manifest_.erase("finished_utc");
-  run.manifest_.erase("error");
+  if (run.manifest_.contains("interrupted")) entry["interrupted"] = run.manifest_["interrupted"];
+  for (const char* key : {"finished_utc", "error", "interrupted"}) run.manifest_.erase(key);
   run.manifest_["resumed"].push_back(entry);
   run.write_manifest();
   return run;

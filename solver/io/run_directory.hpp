@@ -5,7 +5,8 @@
 //    It is written first, with "status": "running", and rewritten by finish() with the final
 //    status (ok | input_error | diverged | failed). A directory whose manifest still says
 //    "running" belongs to a process that was killed: run_status() reports it "incomplete",
-//    never as a result.
+//    never as a result. A run stopped on request (SIGINT, SIGTERM: core/interrupt.hpp) writes
+//    its checkpoint and finishes "failed" with an "interrupted" entry (signal, step).
 //  - Every text file appears complete or not at all: it is written to `name.tmp` in the same
 //    directory, fsync'ed, renamed over `name`, and the directory is fsync'ed.
 //  - HDF5 files are written as `name.partial` and renamed to `name` by commit_file(); a run
@@ -40,9 +41,10 @@ class RunDirectory {
 
   /// Reopens the directory of an interrupted run to continue it from its checkpoint.h5
   /// (`caplab run --resume`): the manifest says "running" again and lists the resume under
-  /// "resumed". Only a run that was killed (status "running") or failed for a reason other
-  /// than its input or numerics ("failed") can be resumed; anything else, or a directory
-  /// without checkpoint.h5, is refused with a core::InputError that says why and what to do.
+  /// "resumed" (with the error and "interrupted" entry it had). Only a run that was killed
+  /// (status "running"), stopped on request or failed for a reason other than its input or
+  /// numerics (both "failed") can be resumed; anything else, or a directory without
+  /// checkpoint.h5, is refused with a core::InputError that says why and what to do.
   static RunDirectory resume(const std::filesystem::path& dir);
   /// The checks of resume() without changing anything.
   static void check_resumable(const std::filesystem::path& dir);

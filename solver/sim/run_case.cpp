@@ -6,6 +6,7 @@
 
 #include "case/load_case.hpp"
 #include "core/build_info.hpp"
+#include "core/interrupt.hpp"
 #include "core/threads.hpp"
 #include "io/checkpoint.hpp"
 #include "io/manifest.hpp"
@@ -70,6 +71,7 @@ RunResult drive(const cases::CaseSpec& spec, const LatticeUnits& units, int thre
   policy.wall_seconds = spec.outputs.checkpoint.wall_seconds;
   policy.meta = checkpoint_meta(spec, threads).dump();
   if (const char* kill = std::getenv("CAPLAB_TEST_KILL_AFTER_CHECKPOINT")) policy.kill_after = std::atoi(kill);
+  if (const char* at = std::getenv("CAPLAB_TEST_SIGTERM_AT_STEP")) policy.sigterm_at_step = std::atol(at);
   const Drive d{dir, progress, policy, restore_from};
   try {
     RunResult r = spec.physics.dimension == 2 ? dispatch_precision<lattice::D2Q9>(spec, units, d)
@@ -85,6 +87,10 @@ RunResult drive(const cases::CaseSpec& spec, const LatticeUnits& units, int thre
                       {"stage_share", share},
                       {"checkpoints", r.checkpoints}});
     return r;
+  } catch (const core::Interrupted& e) {
+    // Resumable (RunDirectory::check_resumable); the manifest says who stopped it and when.
+    dir.finish("failed", {{"error", e.what()}, {"interrupted", {{"signal", core::signal_name(e.signal())}, {"step", e.step()}}}});
+    throw;
   } catch (const core::NumericalError& e) {
     dir.finish("diverged", {{"error", e.what()}, {"step", e.step()}, {"where", e.where()}, {"cause", e.cause()}});
     throw;

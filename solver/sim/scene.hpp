@@ -24,6 +24,7 @@
 
 #include "case/case_spec.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/timing.hpp"
 #include "case/case_consistency.hpp"
 #include "diagnostics/capsule_motion.hpp"
@@ -57,6 +58,9 @@ struct CheckpointPolicy {
   /// Tests only: the process kills itself (SIGKILL) right after its n-th checkpoint, as a
   /// power cut would (CAPLAB_TEST_KILL_AFTER_CHECKPOINT, read by sim/run_case.cpp).
   int kill_after = 0;
+  /// Tests only: the process sends itself SIGTERM during step n, as a batch system's stop
+  /// would (CAPLAB_TEST_SIGTERM_AT_STEP).
+  long sigterm_at_step = 0;
 };
 
 struct RunResult {
@@ -160,8 +164,11 @@ class Scene {
         core::timed(seconds_fluid_, [&] { fluid_.step(hook, swept); });
         const double t = step * dt;
         if (!capsules_.empty()) core::timed(seconds_diagnostics_, [&] { track_capsules(); });
+        if (step == policy.sigterm_at_step) std::raise(SIGTERM);
+        // A stop request (core/interrupt.hpp) ends the run after this step and its checkpoint.
+        const bool stop = step < total && core::stop_signal() != 0;
         const bool checkpoint_due =
-            step < total && ((every_steps > 0 && step % every_steps == 0) ||
+            step < total && (stop || (every_steps > 0 && step % every_steps == 0) ||
                              (policy.wall_seconds > 0 && seconds_since(last_checkpoint) >= policy.wall_seconds));
         // A checkpoint is always a state that passed the guards (the last good state).
         if (step % guard_every == 0 || step == total || checkpoint_due)
@@ -176,6 +183,17 @@ class Scene {
         if (checkpoint_due) {
           write_checkpoint(dir, snapshots ? &*snapshots : nullptr, policy);
           last_checkpoint = clock::now();
+        }
+        if (stop) {
+          series.close();
+          if (snapshots) snapshots->close();
+          const int signal = core::stop_signal();
+          throw core::Interrupted(
+              signal, step,
+              fmt::format("stopped by {} after step {} of {} (t = {:.6g} L/U); the state is in {}: continue with "
+                          "`caplab run --resume {}`. The series so far is in series.h5.partial (not a result)",
+                          core::signal_name(signal), step, total, t, dir.path("checkpoint.h5").string(),
+                          dir.root().string()));
         }
         if (progress && clock::now() - last_report > std::chrono::seconds(1)) {
           const double per_step = seconds_since(start_) / static_cast<double>(step - first_step_);
