@@ -306,9 +306,13 @@ def load_run(directory: Path | None, case_id: str, fidelity: str, side: Path | N
 
     if run.manifest:
         status = run.manifest.get("status")
-        run.status = "incomplete" if status in (None, "running") else str(status)
+        stopped = run.manifest.get("interrupted") if status == "failed" else None
+        run.status = "incomplete" if status in (None, "running") or stopped else str(status)
         if status == "running":
             run.problems.append("manifest.json still says \"running\": the process was killed or is still going")
+        if isinstance(stopped, dict):
+            run.problems.append(f"stopped by {stopped.get('signal')} after step {stopped.get('step')}, checkpoint "
+                                "kept: `caplab run --resume` (or the next reproduce) continues it")
     elif run.reproduce:
         code = run.reproduce.get("exit_code")
         run.status = EXIT_STATUS.get(code, "failed") if isinstance(code, int) else "failed"

@@ -105,14 +105,14 @@ int run(const RunArgs& args, bool terminal) {
     else if (step % std::max(1L, total / 10) < std::max(1L, total / 200))
       fmt::print(stderr, "{}\n", line);
   };
-  const sim::RunOptions options{args.keep_checkpoint};
+  const sim::RunOptions options{args.keep_checkpoint,
+                                [](const std::string& w) { fmt::print(stderr, "caplab: warning: {}\n", w); }};
   fs::path out = args.out;
   sim::RunResult r;
   if (!args.resume.empty()) {
     out = args.resume;
     fmt::print("resuming {} from its checkpoint\n", out.string());
     auto resumed = sim::resume_case(out, args.threads, progress, options);
-    for (const auto& w : resumed.warnings) fmt::print(stderr, "caplab: warning: {}\n", w);
     r = std::move(resumed.result);
   } else {
     const auto spec = cases::load_case(args.case_file, args.fidelity, args.overrides);

@@ -119,6 +119,8 @@ RunResult run_case(const cases::CaseSpec& spec, const std::filesystem::path& out
   const LatticeUnits units = derive_units(spec);  // input errors surface before the directory exists
   check_memory(spec, units, machine_memory_bytes());  // and before anything large is allocated
   const int threads = core::apply_thread_count(spec.numerics.threads);
+  if (threads > 1 && options.warn)
+    if (const auto w = core::contention_warning(threads, core::other_running_tasks())) options.warn(*w);
   auto dir = io::RunDirectory::create(out, /*overwrite=*/true);
   nlohmann::json resolved = spec.resolved;
   resolved["fidelity_applied"] = spec.fidelity;
@@ -152,18 +154,22 @@ ResumedRun resume_case(const std::filesystem::path& run_dir, int threads, const 
   check_memory(spec, units, machine_memory_bytes());  // the machine resumed on may have less
   const int used = core::apply_thread_count(spec.numerics.threads);
   const auto& b = core::build_info();
-  std::vector<std::string> warnings;
+  auto warn = [&](const std::string& w) {
+    if (options.warn) options.warn(w);
+  };
   if (used != saved_threads)
-    warnings.push_back(fmt::format("the run started with {} threads and continues with {}: results agree to "
-                                   "round-off, not bit for bit",
-                                   saved_threads, used));
+    warn(fmt::format("the run started with {} threads and continues with {}: results agree to round-off, not bit "
+                     "for bit",
+                     saved_threads, used));
   if (meta.at("git_sha").get<std::string>() != b.git_sha || meta.at("git_dirty").get<bool>() != b.git_dirty ||
       meta.at("flags").get<std::string>() != std::string(b.flags))
-    warnings.push_back("the run started with another build of caplab (git " + meta.at("git_sha").get<std::string>() +
-                       "): results may differ from an uninterrupted run at round-off");
+    warn("the run started with another build of caplab (git " + meta.at("git_sha").get<std::string>() +
+         "): results may differ from an uninterrupted run at round-off");
+  if (used > 1)
+    if (const auto w = core::contention_warning(used, core::other_running_tasks())) warn(*w);
   auto dir = io::RunDirectory::resume(run_dir);
   dir.update_manifest({{"threads", used}, {"environment", io::environment_json(used)}});
-  ResumedRun r{spec, warnings, {}};
+  ResumedRun r{spec, {}};
   r.result = drive(spec, units, used, dir, progress, options, &reader);
   return r;
 }

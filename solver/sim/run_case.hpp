@@ -4,6 +4,8 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
+#include <string>
 
 #include "case/case_spec.hpp"
 #include "sim/scene.hpp"
@@ -13,6 +15,9 @@ namespace caplab::sim {
 /// Choices of the command line that are not part of the case.
 struct RunOptions {
   bool keep_checkpoint = false;  ///< keep checkpoint.h5 when the run finishes ok
+  /// Told, before the first step, what the user should know: the cores are busy with other
+  /// work (core::contention_warning), a resume with another thread count or build.
+  std::function<void(const std::string&)> warn;
 };
 
 /// Runs `spec` into the run directory `out` (created fresh; a previous run there is
@@ -23,11 +28,9 @@ struct RunOptions {
 RunResult run_case(const cases::CaseSpec& spec, const std::filesystem::path& out, const ProgressFn& progress,
                    const RunOptions& options = {});
 
-/// A run continued by resume_case: the case as rebuilt from the checkpoint, what the user
-/// should know (another thread count or build), and the result.
+/// A run continued by resume_case: the case as rebuilt from the checkpoint, and the result.
 struct ResumedRun {
   cases::CaseSpec spec;
-  std::vector<std::string> warnings;
   RunResult result;
 };
 

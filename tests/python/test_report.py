@@ -163,6 +163,18 @@ def test_killed_run_is_incomplete(tmp_path):
     assert run.status == "incomplete" and run.verdict == "fail" and run.sanity == "fail"
 
 
+def test_stopped_run_is_incomplete(tmp_path):
+    """Ctrl-C or SIGTERM: caplab finished the manifest "failed" with an "interrupted" entry."""
+    case = fakes.cylinder_case()
+    run_dir = fakes.make_run_dir(tmp_path / "quick" / "ch2__cylinder_re100", case, "quick", "running")
+    manifest = json.loads((run_dir / "manifest.json").read_text())
+    manifest.update(status="failed", interrupted={"signal": "SIGINT", "step": 1200})
+    fakes.write_json(run_dir / "manifest.json", manifest)
+    run = load_run(run_dir, case["id"], "quick")
+    assert run.status == "incomplete" and run.verdict == "fail"
+    assert any("stopped by SIGINT after step 1200" in p for p in run.problems)
+
+
 def test_unscored_run_is_not_a_pass(tmp_path):
     case = fakes.cylinder_case()
     run_dir = fakes.make_run_dir(tmp_path / "r", case, "quick", "pass")
@@ -210,10 +222,16 @@ sys.path.insert(0, {here!r})
 import fakes
 args = sys.argv[1:]
 assert args[0] == "run", args
-case_file, fidelity, out = args[1], args[args.index("--fidelity") + 1], args[args.index("--out") + 1]
-case = json.load(open(case_file))
+if args[1] == "--resume":  # continues the run directory: its case and level as it recorded them
+    out = args[2]
+    case = json.load(open(os.path.join(out, "case.json")))
+    fidelity, call = json.load(open(os.path.join(out, "manifest.json")))["fidelity"], "resume"
+else:
+    case_file, fidelity, out = args[1], args[args.index("--fidelity") + 1], args[args.index("--out") + 1]
+    case = json.load(open(case_file))
+    call = fidelity
 calls = os.environ["FAKE_CAPLAB_CALLS"]
-open(os.path.join(calls, case["id"].replace("/", "__") + "." + fidelity + "." + uuid.uuid4().hex), "w").close()
+open(os.path.join(calls, case["id"].replace("/", "__") + "." + call + "." + uuid.uuid4().hex), "w").close()
 time.sleep(float(os.environ.get("FAKE_CAPLAB_SLEEP", "0")))
 if "bad_input" in case["id"]:
     print("error: " + case_file + ": /physics/reynolds: expected a number > 0", file=sys.stderr)
@@ -312,6 +330,45 @@ def test_reproduce_reruns_killed_run(reproduce_env):
     fakes.write_json(manifest, data)
     r(paths=[case_file])
     assert count("ch2/cylinder_re100") == 2
+
+
+def test_reproduce_resumes_stopped_run(reproduce_env):
+    """A run stopped by a signal (or killed) after a checkpoint continues from it; not with --force,
+    nor when the binary changed."""
+    r, count, results = reproduce_env["reproduce"], reproduce_env["count"], reproduce_env["results"]
+    case_file = str(reproduce_env["catalogue"] / "ch2" / "cylinder_re100.json")
+    assert r(paths=[case_file]).returncode == 0
+    run_dir = results / "quick" / "ch2__cylinder_re100"
+    manifest = run_dir / "manifest.json"
+    data = json.loads(manifest.read_text())
+
+    def stop(status, **extra):
+        fakes.write_json(manifest, dict(data, status=status, **extra))
+        (run_dir / "series.h5").unlink(missing_ok=True)
+        (run_dir / "checkpoint.h5").write_bytes(b"state")
+
+    stop("failed", interrupted={"signal": "SIGINT", "step": 1200}, error="stopped by SIGINT")
+    out = r(paths=[case_file])
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "resumed" in out.stdout and count("ch2/cylinder_re100.resume") == 1
+    stamp = json.loads((results / "quick" / "ch2__cylinder_re100.reproduce.json").read_text())
+    assert stamp["command"][1:3] == ["run", "--resume"] and stamp["resumed"] and stamp["status"] == "ok"
+    assert r(paths=[case_file]).stdout.count("skipped") == 1  # finished now: up to date
+
+    stop("running")  # killed after a checkpoint
+    r(paths=[case_file])
+    assert count("ch2/cylinder_re100.resume") == 2
+    stop("failed", error="disk full")  # any other failure runs afresh
+    r(paths=[case_file])
+    assert count("ch2/cylinder_re100.resume") == 2 and count("ch2/cylinder_re100.quick") == 2
+    stop("running")
+    r("--force", paths=[case_file])
+    assert count("ch2/cylinder_re100.resume") == 2 and count("ch2/cylinder_re100.quick") == 3
+    stop("running")
+    with open(reproduce_env["caplab"], "a") as fh:
+        fh.write("# rebuilt\n")
+    r(paths=[case_file])
+    assert count("ch2/cylinder_re100.resume") == 2 and count("ch2/cylinder_re100.quick") == 4
 
 
 def test_reproduce_parallel_invocations_share_nothing(reproduce_env):

@@ -39,5 +39,23 @@ TEST(Threads, OmpNumThreadsIsKeptWhenNothingIsRequested) {
   }
 }
 
+TEST(Threads, WarnsWhenOtherWorkLeavesTooFewCores) {
+  const int usable = usable_processors();
+  EXPECT_FALSE(contention_warning(1, usable + 4));   // one thread waits for nobody
+  EXPECT_FALSE(contention_warning(2, std::nullopt));  // unknown: no guess
+  if (usable >= 2) {
+    EXPECT_FALSE(contention_warning(2, usable - 2));  // two cores free
+  }
+  const auto w = contention_warning(2, usable - 1);  // one core free
+  ASSERT_TRUE(w);
+  EXPECT_NE(w->find("--threads 1"), std::string::npos) << *w;
+}
+
+TEST(Threads, OtherRunningTasksAreReadFromTheKernel) {
+  const auto others = other_running_tasks();
+  ASSERT_TRUE(others);  // Linux /proc/loadavg
+  EXPECT_GE(*others, 0);
+}
+
 }  // namespace
 }  // namespace caplab::core
