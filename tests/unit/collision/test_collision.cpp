@@ -420,6 +420,25 @@ TYPED_TEST(StreamingTest, ForcedCollisionAtNodesEqualsTheForcedKernel) {
     for (const bool spans : {false, true}) check_forced_collision_at_nodes<L, T>(density, spans);
 }
 
+TYPED_TEST(StreamingTest, PopulationArraysStartAtDifferentPageOffsets) {
+  // Grids of 8k + 2 nodes per axis hold a multiple of 4 KiB per population: unpadded, node n of
+  // every array lay at the same page offset (half speed, field/populations.hpp).
+  using L = typename TypeParam::L;
+  using T = typename TypeParam::T;
+  using Pop = field::Populations<L, T>;
+  constexpr std::ptrdiff_t line = 64 / sizeof(T);
+  for (std::ptrdiff_t nodes : {1L, 7L, 64L * 64 * 64, 128L * 128 * 128, 130L * 130 * 130, 2048L * 2048}) {
+    const std::ptrdiff_t s = Pop::stride(nodes);
+    EXPECT_GE(s, nodes);
+    EXPECT_LT(s, nodes + 2 * line);
+    EXPECT_EQ(s % line, 0);
+    std::vector<std::ptrdiff_t> offsets;
+    for (int i = 0; i < L::q; ++i) offsets.push_back(i * s * static_cast<std::ptrdiff_t>(sizeof(T)) % 4096);
+    std::sort(offsets.begin(), offsets.end());
+    EXPECT_EQ(std::unique(offsets.begin(), offsets.end()), offsets.end()) << nodes << " nodes";
+  }
+}
+
 TEST(CoverWithSpans, SpansAreDisjointRowStretchesOfWholeChunksThatCoverEveryNode) {
   // Nodes at the start, middle and end of rows; neighbours closer than 2W merge.
   constexpr int W = 4;
