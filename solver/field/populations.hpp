@@ -97,8 +97,9 @@ class Populations {
     std::int64_t s = stride(grid_.size());
     ar(prefix + "population_stride", s);
     if (s != stride(grid_.size()))
-      throw core::Error("checkpoint: " + prefix + " holds " + std::to_string(s) + " values per population, this build " +
-                  std::to_string(stride(grid_.size())) + ": resume it with the build that wrote it or run afresh");
+      throw core::Error("checkpoint: " + prefix + " holds " + std::to_string(s) +
+                        " values per population, this build " + std::to_string(stride(grid_.size())) +
+                        ": resume it with the build that wrote it or run afresh");
     ar(prefix + "populations_in_place", std::span<T>(buf_));
     ar(prefix + "parity", parity_);
   }

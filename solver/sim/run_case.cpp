@@ -89,7 +89,8 @@ RunResult drive(const cases::CaseSpec& spec, const LatticeUnits& units, int thre
     return r;
   } catch (const core::Interrupted& e) {
     // Resumable (RunDirectory::check_resumable); the manifest says who stopped it and when.
-    dir.finish("failed", {{"error", e.what()}, {"interrupted", {{"signal", core::signal_name(e.signal())}, {"step", e.step()}}}});
+    dir.finish("failed", {{"error", e.what()},
+                          {"interrupted", {{"signal", core::signal_name(e.signal())}, {"step", e.step()}}}});
     throw;
   } catch (const core::NumericalError& e) {
     dir.finish("diverged", {{"error", e.what()}, {"step", e.step()}, {"where", e.where()}, {"cause", e.cause()}});
