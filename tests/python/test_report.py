@@ -6,8 +6,10 @@ from __future__ import annotations
 import json
 import os
 import re
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -257,14 +259,16 @@ def reproduce_env(tmp_path):
     env = dict(os.environ, FAKE_CAPLAB_CALLS=str(calls))
     results = tmp_path / "results"
 
-    def reproduce(*extra, fidelity="quick", paths=None, report=False, env_extra=None, background=False):
+    def reproduce(*extra, fidelity="quick", paths=None, report=False, env_extra=None, background=False,
+                  new_session=False):
         cmd = [PYTHON, str(REPO / "scripts" / "reproduce"), "--caplab", str(caplab), "--fidelity", fidelity,
                "--results", str(results), *extra, *(paths or [str(catalogue)])]
         cmd += ["--report-out", str(tmp_path / "out"), "--catalogue", str(catalogue), "--no-pdf"] if report \
             else ["--no-report"]
         e = dict(env, **(env_extra or {}))
         if background:
-            return subprocess.Popen(cmd, env=e, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            return subprocess.Popen(cmd, env=e, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                    start_new_session=new_session)
         return subprocess.run(cmd, env=e, capture_output=True, text=True, timeout=300)
 
     def count(case_id=None):
@@ -369,6 +373,22 @@ def test_reproduce_resumes_stopped_run(reproduce_env):
         fh.write("# rebuilt\n")
     r(paths=[case_file])
     assert count("ch2/cylinder_re100.resume") == 2 and count("ch2/cylinder_re100.quick") == 4
+
+
+def test_reproduce_ctrl_c_starts_no_further_case(reproduce_env):
+    """Ctrl-C reaches reproduce and the running caplab (one process group): the running case stops
+    (caplab checkpoints it), the queued ones do not start, and reproduce exits 130."""
+    r, count = reproduce_env["reproduce"], reproduce_env["count"]
+    proc = r(env_extra={"FAKE_CAPLAB_SLEEP": "3"}, background=True, new_session=True)
+    deadline = time.monotonic() + 60
+    while count() == 0 and time.monotonic() < deadline:
+        time.sleep(0.1)
+    time.sleep(0.5)
+    os.killpg(proc.pid, signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, out + err
+    assert count() == 1, out + err
+    assert "interrupted" in err
 
 
 def test_reproduce_parallel_invocations_share_nothing(reproduce_env):
