@@ -24,13 +24,13 @@ template <class L, class T>
   return s;
 }
 
-/// ρ = 1 + Σ f_i and j = Σ c_i f_i from shifted populations f.
+/// δρ = Σ f_i and j = Σ c_i f_i from shifted populations f (ρ = 1 + δρ).
 /// Scalars and references to C arrays only: this is what the vectorized kernel calls (an
 /// aggregate or a pointer to a per-lane array inside an `omp simd` loop stops GCC 12 from
 /// vectorizing it; checked with -fopt-info-vec).
 template <class L, class T>
-inline void density_momentum(const T (&f)[L::q], T& rho, T (&j)[L::d]) {
-  T drho = 0;
+inline void shifted_density_momentum(const T (&f)[L::q], T& drho, T (&j)[L::d]) {
+  drho = 0;
   for (int a = 0; a < L::d; ++a) j[a] = 0;
 #pragma GCC unroll 19
   for (int i = 0; i < L::q; ++i) {
@@ -40,6 +40,13 @@ inline void density_momentum(const T (&f)[L::q], T& rho, T (&j)[L::d]) {
       if (L::c[i][a] < 0) j[a] -= f[i];
     }
   }
+}
+
+/// ρ = 1 + Σ f_i and j = Σ c_i f_i of shifted populations.
+template <class L, class T>
+inline void density_momentum(const T (&f)[L::q], T& rho, T (&j)[L::d]) {
+  T drho;
+  shifted_density_momentum<L, T>(f, drho, j);
   rho = T(1) + drho;
 }
 

@@ -29,7 +29,13 @@
 // are tensor products, so a face is interpolated axis by axis on whole rows of one population
 // (structure of arrays, vector loops): the coarse plane under the face in time, then along the
 // first in-face axis u onto the fine spacing, then along the second, v (3D), row by row just
-// before the row's ghosts are collided. The history keeps the coarse planes, not whole nodes.
+// before the row's ghosts are collided. The history keeps the coarse planes, not whole nodes,
+// and of each plane node only what its face's ghosts use (channels): the density and momentum
+// (D + 1 values) and the populations that enter through the face and their opposites (2E);
+// 14 of 19 values in D3Q19 (9 of 9 in D2Q9), 4 + 5 of them with BGK, whose rescaling and
+// collision need no opposite. The moments and the interpolation are linear, so interpolated
+// moments are the moments of the interpolated populations (to round-off): the ghosts' ρ and u
+// come from them.
 //
 // One coarse step: collide_band(), the coarse collide-push (in place, parity flip) +
 // boundaries, capture_coarse(); two fine substeps, each: collide-push, fill_fine_ghosts(s) with
@@ -45,6 +51,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -62,6 +69,14 @@ class TwoLevel {
   static constexpr int D = L::d;
   static constexpr int Q = L::q;
   static constexpr int m = 2;
+  /// Populations entering through one face (the links of its ghosts), and the channels a face
+  /// keeps of each coarse plane node: δρ, j, the entering populations, their opposites.
+  static constexpr int E = [] {
+    int n = 0;
+    for (int i = 0; i < Q; ++i) n += lattice::enters_through_face<L>(0, i) ? 1 : 0;
+    return n;
+  }();
+  static constexpr int C = D + 1 + 2 * E;
 
   TwoLevel() = default;
   /// Relaxation times of the even (τ+) and odd (τ−) non-equilibrium parts of one block.
@@ -78,7 +93,7 @@ class TwoLevel {
                  "two-level coupling needs coarse spacing = 2 × fine spacing");
     build_restriction();
     build_faces();
-    history_.assign(3 * Q * sources_.size(), T(0));
+    history_.assign(3 * C * sources_.size(), T(0));
   }
 
   /// Records the coarse populations needed by the fine ghosts at the new coarse time level.
@@ -101,8 +116,10 @@ class TwoLevel {
     // 3-point Lagrange through t_{n-1} = −1, t_n = 0, t_{n+1} = 1 (eq. 2.14).
     const T lag[3] = {T(0.5 * s * (s - 1.0)), T((1.0 - s) * (1.0 + s)), T(0.5 * s * (s + 1.0))};
     const std::size_t S = sources_.size();
-    const T* h[3] = {&history_[(newest_ + 1) % 3 * Q * S], &history_[(newest_ + 2) % 3 * Q * S],
-                     &history_[newest_ * Q * S]};  // t_{n-1}, t_n, t_{n+1}
+    const T* h[3] = {&history_[(newest_ + 1) % 3 * C * S], &history_[(newest_ + 2) % 3 * C * S],
+                     &history_[newest_ * C * S]};  // t_{n-1}, t_n, t_{n+1}
+    // BGK rescales and collides each population alone: the opposites' channels are not read.
+    constexpr int channels = std::is_same_v<Op, collision::Bgk> ? D + 1 + E : C;
     const std::array<T*, Q> P = fine.bases();
     // Scratch per thread, sized once (and again only if more threads run than before).
     const std::size_t threads = static_cast<std::size_t>(omp_get_max_threads());
@@ -114,38 +131,38 @@ class TwoLevel {
       const Face& fc = faces_[ch.face];
       const int cu_n = fc.axis[0].coarse, row = fc.row;
       T* in_time = scratch_[omp_get_thread_num()].data();  // one coarse row (s > 0)
-      T* along_u = in_time + max_coarse_u_;                // [i][coarse v − cv0][row]
+      T* along_u = in_time + max_coarse_u_;                // [channel][coarse v − cv0][row]
       // The chunk's coarse rows: in time (at s = 0 the formula gives the level t_n), along u.
-      for (int i = 0; i < Q; ++i)
+      for (int k = 0; k < channels; ++k)
         for (int cv = ch.cv0; cv < ch.cv1; ++cv) {
-          const std::size_t at = i * S + fc.first_source + static_cast<std::size_t>(cv) * cu_n;
+          const std::size_t at = k * S + fc.first_source + static_cast<std::size_t>(cv) * cu_n;
           const T* coarse_row = h[1] + at;
           if (s != 0.0) {
 #pragma omp simd
             for (int cu = 0; cu < cu_n; ++cu) in_time[cu] = lag[0] * h[0][at + cu] + lag[1] * h[1][at + cu] + lag[2] * h[2][at + cu];
             coarse_row = in_time;
           }
-          fc.axis[0].interpolate(coarse_row, along_u + (i * (ch.cv1 - ch.cv0) + cv - ch.cv0) * row);
+          fc.axis[0].interpolate(coarse_row, along_u + (k * (ch.cv1 - ch.cv0) + cv - ch.cv0) * row);
         }
       // Its ghost rows along v, a batch at a time, then their collision and push.
       for (int fv = ch.fv0; fv < ch.fv1; ++fv) {
         const auto [first, count] = fc.axis[1].stencil(fv);
         const T* u_rows = along_u + (first - ch.cv0) * row;
-        const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(ch.cv1 - ch.cv0) * row;  // between populations
+        const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(ch.cv1 - ch.cv0) * row;  // between channels
         for (int b0 = 0; b0 < row; b0 += batch) {
-          T coarse_f[Q][batch];
-          for (int i = 0; i < Q; ++i) {
-            const T* r0 = u_rows + i * stride + b0;
+          T coarse_c[C][batch];
+          for (int k = 0; k < channels; ++k) {
+            const T* r0 = u_rows + k * stride + b0;
             if (count == 1) {
 #pragma omp simd
-              for (int b = 0; b < batch; ++b) coarse_f[i][b] = r0[b];
+              for (int b = 0; b < batch; ++b) coarse_c[k][b] = r0[b];
             } else {
 #pragma omp simd
               for (int b = 0; b < batch; ++b)
-                coarse_f[i][b] = midpoint(r0[b], r0[row + b], r0[2 * row + b], r0[3 * row + b]);
+                coarse_c[k][b] = midpoint(r0[b], r0[row + b], r0[2 * row + b], r0[3 * row + b]);
             }
           }
-          collide_ghosts_of(ch.face, coarse_f, P, op_fine, fc.first_ghost + static_cast<std::ptrdiff_t>(fv) * row + b0,
+          collide_ghosts_of(ch.face, coarse_c, P, op_fine, fc.first_ghost + static_cast<std::ptrdiff_t>(fv) * row + b0,
                             std::make_integer_sequence<int, 2 * D>());
         }
       }
@@ -219,26 +236,52 @@ class TwoLevel {
 
   /// collide_ghosts with the face as a compile-time constant.
   template <class Op, int... Faces>
-  void collide_ghosts_of(int face, const T (&coarse_f)[Q][batch], const std::array<T*, Q>& P, const Op& op,
+  void collide_ghosts_of(int face, const T (&coarse_c)[C][batch], const std::array<T*, Q>& P, const Op& op,
                          std::ptrdiff_t k0, std::integer_sequence<int, Faces...>) const {
-    ((face == Faces ? collide_ghosts<Faces>(coarse_f, P, op, k0) : void()), ...);
+    ((face == Faces ? collide_ghosts<Faces>(coarse_c, P, op, k0) : void()), ...);
   }
 
-  /// Ghosts k0 … k0 + batch − 1 of face Face from their interpolated coarse populations:
-  /// rescaled to the fine block, collided with the fine operator, then pushed along their
-  /// links. Only the populations that enter the interior from the face are kept (5 of 19 in
-  /// D3Q19; every link of a ghost of the face is one of them): the compiler drops the rest of
-  /// the rescaling and collision, as in the far field (boundary/boundary_set.hpp).
+  /// The populations of face `face`'s channels D + 1 … C − 1: the E entering ones (increasing
+  /// i), then their opposites in the same order.
+  static constexpr std::array<int, 2 * E> channel_populations(int face) {
+    std::array<int, 2 * E> pops{};
+    int e = 0;
+    for (int i = 0; i < Q; ++i)
+      if (lattice::enters_through_face<L>(face, i)) pops[e] = i, pops[E + e] = L::opposite[i], ++e;
+    return pops;
+  }
+
+  /// Ghosts k0 … k0 + batch − 1 of face Face from their interpolated coarse channels: ρ and u
+  /// from the moments, the kept populations rescaled to the fine block and collided with the
+  /// fine operator, then pushed along their links. Only the populations that enter the interior
+  /// from the face are stored (5 of 19 in D3Q19; every link of a ghost of the face is one of
+  /// them); the compiler drops the rest of the equilibrium.
   template <int Face, class Op>
-  void collide_ghosts(const T (&coarse_f)[Q][batch], const std::array<T*, Q>& P, const Op& op,
+  void collide_ghosts(const T (&coarse_c)[C][batch], const std::array<T*, Q>& P, const Op& op,
                       std::ptrdiff_t k0) const {
+    constexpr std::array<int, 2 * E> pops = channel_populations(Face);
+    constexpr bool split = !std::is_same_v<Op, collision::Bgk>;  // even and odd parts apart
+    const T s_plus = T(f_from_c_.plus), s_minus = T(f_from_c_.minus);
     T post[Q][batch];
 #pragma omp simd
     for (int b = 0; b < batch; ++b) {
-      T f[Q], feq[Q], out[Q];
+      const T rho = T(1) + coarse_c[0][b];
+      T u[D];
+      for (int a = 0; a < D; ++a) u[a] = coarse_c[1 + a][b] / rho;
+      T feq[Q], f[Q], out[Q];
+      collision::equilibrium<L, T>(rho, u, feq);
 #pragma GCC unroll 19
-      for (int i = 0; i < Q; ++i) f[i] = coarse_f[i][b];
-      rescale_non_equilibrium(f, feq, f_from_c_);
+      for (int i = 0; i < Q; ++i) f[i] = feq[i];  // the populations no channel keeps: unused
+      T neq[2 * E];
+#pragma GCC unroll 10
+      for (int e = 0; e < (split ? 2 * E : E); ++e) neq[e] = coarse_c[D + 1 + e][b] - feq[pops[e]];
+      // f ← f_eq + s+ (even part of f_neq) + s− (odd part), the rescaling to the fine block.
+#pragma GCC unroll 10
+      for (int e = 0; e < (split ? 2 * E : E); ++e) {
+        const int o = e < E ? e + E : e - E;
+        f[pops[e]] = split ? feq[pops[e]] + T(0.5) * s_plus * (neq[e] + neq[o]) + T(0.5) * s_minus * (neq[e] - neq[o])
+                           : feq[pops[e]] + s_plus * neq[e];
+      }
       op.template collide<L, T>(f, feq, out);
 #pragma GCC unroll 19
       for (int i = 0; i < Q; ++i)
@@ -398,7 +441,7 @@ class TwoLevel {
           }
           chunks_.push_back(ch);
           max_coarse_u_ = std::max<std::size_t>(max_coarse_u_, fc.axis[0].coarse);
-          scratch_size_ = std::max<std::size_t>(scratch_size_, static_cast<std::size_t>(Q) * (ch.cv1 - ch.cv0) * fc.row);
+          scratch_size_ = std::max<std::size_t>(scratch_size_, static_cast<std::size_t>(C) * (ch.cv1 - ch.cv0) * fc.row);
         }
         for (int fv = 0; fv < fc.axis[1].fine; ++fv) {
           for (int fu = 0; fu < fc.row; ++fu) {
@@ -518,13 +561,26 @@ class TwoLevel {
     }
   }
 
+  /// The channels of every face's plane nodes at the coarse block's current time level.
   void store_level(const field::Populations<L, T>& coarse, int level) {
     const std::size_t S = sources_.size();
     const std::array<const T*, Q> P = coarse.bases();
-    T* out = &history_[level * Q * S];
-#pragma omp parallel for collapse(2) schedule(static)
-    for (int i = 0; i < Q; ++i)
-      for (std::size_t k = 0; k < S; ++k) out[i * S + k] = P[i][sources_[k]];
+    T* out = &history_[level * C * S];
+#pragma omp parallel
+    for (int face = 0; face < 2 * D; ++face) {
+      const auto pops = channel_populations(face);
+      const std::size_t first = faces_[face].first_source;
+      const std::size_t last = face + 1 < 2 * D ? faces_[face + 1].first_source : S;
+#pragma omp for schedule(static) nowait
+      for (std::size_t k = first; k < last; ++k) {
+        T f[Q], drho, j[D];
+        for (int i = 0; i < Q; ++i) f[i] = P[i][sources_[k]];
+        collision::shifted_density_momentum<L, T>(f, drho, j);
+        out[k] = drho;
+        for (int a = 0; a < D; ++a) out[(1 + a) * S + k] = j[a];
+        for (int e = 0; e < 2 * E; ++e) out[(D + 1 + e) * S + k] = f[pops[e]];
+      }
+    }
   }
 
   field::Grid<D> coarse_, fine_;
@@ -535,7 +591,7 @@ class TwoLevel {
   std::vector<Ghost> ghosts_;               // face after face, rows along u padded to batches
   std::vector<Link> links_;
   NodePairs band_;                         // the outermost covered layer (collide_band)
-  std::vector<T> history_;  // [level][i][source]
+  std::vector<T> history_;  // [level][channel][source]
   std::vector<std::vector<T>> scratch_;  // per thread: a coarse row in time, a chunk's rows along u
   std::size_t max_coarse_u_ = 0, scratch_size_ = 0;
   Index<D> cov_lo_{}, cov_hi_{};
