@@ -20,7 +20,8 @@ Definitions used on the page:
                    median over batch pairs: the extra time per node update that the block coupling
                    costs;
   stage shares     manifest "stage_share": fluid (the update without the parts below), coupling (the
-                   two-level grid coupling: ghost fill, restriction), ib (interpolation, spreading, forced
+                   two-level grid coupling: the band's coarse step, the capture of the coarse planes,
+                   the fine ghosts' fill), ib (interpolation, spreading, forced
                    collision), membrane (forces, node motion), diagnostics, output. "IB + membrane" is the
                    fluid-structure coupling of DESIGN.md section 8. A family's share is wall-time weighted:
                    sum(share x wall) / sum(wall) over its runs;
