@@ -29,9 +29,10 @@ std::optional<int> other_running_tasks();
 
 /// A warning when `threads` > 1 threads will find fewer cores free than they need: `others`
 /// (other_running_tasks()) leave fewer than `threads` of the usable processors. The threads
-/// then wait for each other at every barrier while their cores run other work: measured 20-80
-/// times slower on a small 2D case, two threads beside another run on 2 cores (libgomp spins
-/// before it sleeps, and the spinning thread holds the core its partner needs).
+/// then wait for each other at every barrier while their cores run other work: measured 40-80
+/// times slower than with a passive wait, a small 2D case on two threads beside another run on
+/// 2 cores (libgomp spins before it sleeps, and the spinning thread holds the core its partner
+/// needs).
 std::optional<std::string> contention_warning(int threads, std::optional<int> others);
 
 }  // namespace caplab::core
