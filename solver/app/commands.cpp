@@ -5,12 +5,14 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 
 #include "case/load_case.hpp"
 #include "collision/operators.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
+#include "io/run_directory.hpp"
 #include "sim/run_case.hpp"
 #include "sim/units.hpp"
 
@@ -77,11 +79,56 @@ int check(const CheckArgs& args) {
   return 0;
 }
 
+namespace {
+
+/// A JSON file's object, or an empty object when it is missing or unreadable.
+nlohmann::json read_object(const fs::path& file) {
+  std::ifstream in(file);
+  const auto j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  return j.is_object() ? j : nlohmann::json::object();
+}
+
+/// One line per run directory: case, level, what became of it, wall time and verdict.
+void print_run(const fs::path& run, std::size_t width) {
+  const auto m = read_object(run / "manifest.json");
+  const std::string status = io::RunDirectory::run_status(run);
+  std::string state = status;
+  if (status == "incomplete") state = "incomplete (running, or killed)";
+  if (status == "failed" && m.contains("interrupted"))
+    state = fmt::format("stopped by {} after step {} (resumable: caplab run --resume {})",
+                        m["interrupted"].value("signal", "?"), m["interrupted"].value("step", 0L), run.string());
+  if (status == "diverged") state = fmt::format("diverged at step {}", m.value("step", 0L));
+  std::string wall;
+  if (m.contains("wall_time_s")) wall = human_seconds(m["wall_time_s"].get<double>());
+  const auto score = read_object(run / "score.json");
+  fmt::print("{:{}s} {:40s} {:9s} {:7s} {:>9s}  {}\n", run.string(), width, m.value("case_id", std::string("?")),
+             m.value("fidelity", std::string("?")), score.value("verdict", std::string("-")), wall, state);
+}
+
+}  // namespace
+
 int list(const fs::path& dir) {
-  std::vector<fs::path> files;
-  for (const auto& e : fs::recursive_directory_iterator(dir))
-    if (e.path().extension() == ".json" && e.path().filename() != "schema.json") files.push_back(e.path());
+  // Case files; a run directory (manifest.json) is listed as a run and not searched, and the
+  // records scripts/reproduce keeps beside runs are not cases.
+  std::vector<fs::path> files, runs;
+  for (auto it = fs::recursive_directory_iterator(dir); it != fs::recursive_directory_iterator(); ++it) {
+    const fs::path& p = it->path();
+    if (it->is_directory() && io::RunDirectory::is_run_directory(p)) {
+      runs.push_back(p);
+      it.disable_recursion_pending();
+    } else if (p.extension() == ".json" && p.filename() != "schema.json" &&
+               !p.filename().string().ends_with(".reproduce.json")) {
+      files.push_back(p);
+    }
+  }
   std::sort(files.begin(), files.end());
+  std::sort(runs.begin(), runs.end());
+  std::size_t width = 13;  // "run directory"
+  for (const auto& r : runs) width = std::max(width, r.string().size());
+  if (!runs.empty())
+    fmt::print("{:{}s} {:40s} {:9s} {:7s} {:>9s}  {}\n", "run directory", width, "case", "fidelity", "verdict", "wall",
+               "status");
+  for (const auto& r : runs) print_run(r, width);
   for (const auto& f : files) {
     try {
       const auto spec = cases::load_case(f, "standard");

@@ -54,8 +54,10 @@ int main(int argc, char** argv) {
   check_cmd->add_option("--set", check.overrides, "Override a case value: path=value (repeatable)");
 
   std::string list_dir = "catalogue";
-  auto* list_cmd = app.add_subcommand("list", "List the cases of a catalogue directory");
-  list_cmd->add_option("dir", list_dir, "Directory to search (default: catalogue)");
+  auto* list_cmd = app.add_subcommand("list", "List the cases of a catalogue directory, or the runs of a results directory");
+  list_cmd->add_option("dir", list_dir,
+                       "Directory to search (default: catalogue); a run directory is listed with its level, verdict, "
+                       "wall time and status (a stopped run with how to resume it)");
 
   app::ScoreArgs score;
   auto* score_cmd = app.add_subcommand("score", "Score a finished run directory against its references");
