@@ -93,7 +93,11 @@ void print_run(const fs::path& run, std::size_t width) {
   const auto m = read_object(run / "manifest.json");
   const std::string status = io::RunDirectory::run_status(run);
   std::string state = status;
-  if (status == "incomplete") state = "incomplete (running, or killed)";
+  if (status == "incomplete")
+    state = io::RunDirectory::is_running(run) ? "running now"
+            : fs::exists(run / "checkpoint.h5")
+                ? fmt::format("killed (resumable: caplab run --resume {})", run.string())
+                : "killed before its first checkpoint";
   if (status == "failed" && m.contains("interrupted"))
     state = fmt::format("stopped by {} after step {} (resumable: caplab run --resume {})",
                         m["interrupted"].value("signal", "?"), m["interrupted"].value("step", 0L), run.string());

@@ -1,6 +1,7 @@
 #include "io/run_directory.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <array>
@@ -98,7 +99,52 @@ void write_file_atomically(const fs::path& target, std::string_view content) {
   fsync_path(parent_or_dot(target), /*directory=*/true);
 }
 
-RunDirectory::RunDirectory(fs::path root) : root_(std::move(root)) {}
+namespace {
+
+/// An fd of `dir` with `lock` (LOCK_EX or LOCK_SH, non-blocking) taken, or -1 when another open
+/// description holds a conflicting lock (or the directory cannot be opened).
+int lock_directory(const fs::path& dir, int lock) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return -1;
+  if (::flock(fd, lock | LOCK_NB) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+[[noreturn]] void refuse_running(const fs::path& dir) {
+  throw core::InputError("the run in '" + dir.string() +
+                         "' is going on in another process (it holds the directory's lock): wait for it, stop it "
+                         "(Ctrl-C or kill -TERM: it writes a checkpoint), or choose another output directory");
+}
+
+}  // namespace
+
+RunDirectory::RunDirectory(fs::path root) : root_(std::move(root)) {
+  lock_fd_ = lock_directory(root_, LOCK_EX);
+  if (lock_fd_ < 0) refuse_running(root_);
+}
+
+RunDirectory::RunDirectory(RunDirectory&& other) noexcept
+    : root_(std::move(other.root_)), lock_fd_(other.lock_fd_), manifest_(std::move(other.manifest_)),
+      finished_(other.finished_) {
+  other.lock_fd_ = -1;
+}
+
+RunDirectory::~RunDirectory() {
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock
+}
+
+bool RunDirectory::is_running(const fs::path& dir) {
+  const int fd = lock_directory(dir, LOCK_SH);
+  if (fd >= 0) {
+    ::close(fd);
+    return false;
+  }
+  std::error_code ec;
+  return fs::is_directory(dir, ec);  // not lockable although it exists: held by a writer
+}
 
 bool RunDirectory::is_run_directory(const fs::path& dir) {
   const auto m = read_manifest(dir);
@@ -120,6 +166,7 @@ RunDirectory RunDirectory::create(const fs::path& out, bool overwrite) {
       throw core::InputError("output path '" + out.string() +
                              "' exists and is not a directory; choose another output directory");
     if (is_run_directory(out)) {
+      if (is_running(out)) refuse_running(out);
       if (!overwrite)
         throw core::InputError("output directory '" + out.string() +
                                "' holds a previous caplab run (status: " + run_status(out) +
@@ -145,6 +192,7 @@ RunDirectory RunDirectory::create(const fs::path& out, bool overwrite) {
 }
 
 void RunDirectory::check_resumable(const fs::path& dir) {
+  if (is_running(dir)) refuse_running(dir);
   const auto m = read_manifest(dir);
   if (!m || !m->is_object())
     throw core::InputError("'" + dir.string() + "' is not a caplab run directory (no readable manifest.json); "

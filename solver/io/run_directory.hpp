@@ -13,6 +13,9 @@
 //    finished "ok" has no `.partial` or `.tmp` file left.
 //  - Only a previous caplab run directory (or an empty directory) is ever replaced, and only
 //    when the caller asked to overwrite; anything else is refused with an InputError.
+//  - One writer: the RunDirectory holds an exclusive flock on the directory for its lifetime, so
+//    a second `caplab run --out` or `--resume` on a run that is still going is refused instead
+//    of writing into it, and is_running() tells a live run from a killed one.
 //
 // Not thread-safe: one RunDirectory is driven from one thread.
 #pragma once
@@ -55,6 +58,14 @@ class RunDirectory {
 
   /// True if `dir` holds a manifest.json that is a JSON object with a string "status".
   static bool is_run_directory(const std::filesystem::path& dir);
+  /// True while a process holds the run in `dir` (its RunDirectory's lock).
+  static bool is_running(const std::filesystem::path& dir);
+
+  RunDirectory(RunDirectory&& other) noexcept;
+  RunDirectory& operator=(RunDirectory&&) = delete;
+  RunDirectory(const RunDirectory&) = delete;
+  RunDirectory& operator=(const RunDirectory&) = delete;
+  ~RunDirectory();
 
   /// The directory itself.
   const std::filesystem::path& root() const { return root_; }
@@ -85,10 +96,12 @@ class RunDirectory {
   bool finished() const { return finished_; }
 
  private:
+  /// Opens `root` and takes its lock; refuses (InputError) a run another process holds.
   explicit RunDirectory(std::filesystem::path root);
   void write_manifest() const;
 
   std::filesystem::path root_;
+  int lock_fd_ = -1;
   nlohmann::json manifest_;
   bool finished_ = false;
 };

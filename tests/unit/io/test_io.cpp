@@ -565,11 +565,36 @@ TEST_F(IoRunDirectory, ResumeTakesOnlyAnInterruptedRunWithACheckpoint) {
   }
   expect_refused(dir_ / "killed", "finished ok");
   for (const char* status : {"diverged", "input_error"}) {
-    auto run = RunDirectory::create(dir_ / status, false);
-    write_file_atomically(dir_ / status / "checkpoint.h5", "x");
-    run.finish(status);
+    {
+      auto run = RunDirectory::create(dir_ / status, false);
+      write_file_atomically(dir_ / status / "checkpoint.h5", "x");
+      run.finish(status);
+    }
     expect_refused(dir_ / status, status == std::string("diverged") ? "diverge again" : "fix the case");
   }
+}
+
+TEST_F(IoRunDirectory, ARunHeldByItsWriterIsRefusedToOthers) {
+  {
+    auto run = RunDirectory::create(dir_ / "live", false);
+    EXPECT_TRUE(RunDirectory::is_running(run.root()));
+    write_file_atomically(dir_ / "live" / "checkpoint.h5", "x");
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      try {
+        if (attempt == 0) RunDirectory::resume(dir_ / "live");
+        if (attempt == 1) RunDirectory::create(dir_ / "live", true);
+        FAIL() << "a second writer must be refused";
+      } catch (const core::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("another process"), std::string::npos) << e.what();
+      }
+    }
+    auto moved = std::move(run);  // the lock goes with the object
+    EXPECT_TRUE(RunDirectory::is_running(dir_ / "live"));
+  }
+  EXPECT_FALSE(RunDirectory::is_running(dir_ / "live"));  // killed: resumable
+  EXPECT_FALSE(RunDirectory::is_running(dir_ / "does_not_exist"));
+  auto resumed = RunDirectory::resume(dir_ / "live");
+  EXPECT_EQ(resumed.manifest()["resumed"].size(), 1u);
 }
 
 TEST_F(IoRunDirectory, CompareRunsFindsEveryDifference) {
