@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 
 #include "case/load_case.hpp"
@@ -13,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "io/run_directory.hpp"
+#include "score/run_files.hpp"
 #include "sim/run_case.hpp"
 #include "sim/units.hpp"
 
@@ -83,9 +83,7 @@ namespace {
 
 /// A JSON file's object, or an empty object when it is missing or unreadable.
 nlohmann::json read_object(const fs::path& file) {
-  std::ifstream in(file);
-  const auto j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  return j.is_object() ? j : nlohmann::json::object();
+  return score::read_json(file).doc.value_or(nlohmann::json::object());
 }
 
 /// One line per run directory: case, level, what became of it, wall time and verdict.

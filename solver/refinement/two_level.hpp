@@ -77,6 +77,10 @@ class TwoLevel {
     return n;
   }();
   static constexpr int C = D + 1 + 2 * E;
+  /// The channels the fill of operator Op reads (captured and interpolated): BGK rescales and
+  /// collides each population alone, so not the opposites.
+  template <class Op>
+  static constexpr int kept_channels = std::is_same_v<Op, collision::Bgk> ? D + 1 + E : C;
 
   TwoLevel() = default;
   /// Relaxation times of the even (τ+) and odd (τ−) non-equilibrium parts of one block.
@@ -96,14 +100,16 @@ class TwoLevel {
     history_.assign(3 * C * sources_.size(), T(0));
   }
 
-  /// Records the coarse populations needed by the fine ghosts at the new coarse time level.
-  /// Call after the coarse step (and swap); the first call also fills the older levels.
+  /// Records what the fine ghosts of the fill with operator Op need of the coarse block at the
+  /// new coarse time level. Call after the coarse step (and swap); the first call also fills
+  /// the older levels.
+  template <class Op>
   void capture_coarse(const field::Populations<L, T>& coarse) {
     newest_ = (newest_ + 1) % 3;
-    store_level(coarse, newest_);
+    store_level<kept_channels<Op>>(coarse, newest_);
     if (!primed_) {
-      store_level(coarse, (newest_ + 1) % 3);
-      store_level(coarse, (newest_ + 2) % 3);
+      store_level<kept_channels<Op>>(coarse, (newest_ + 1) % 3);
+      store_level<kept_channels<Op>>(coarse, (newest_ + 2) % 3);
       primed_ = true;
     }
   }
@@ -118,8 +124,7 @@ class TwoLevel {
     const std::size_t S = sources_.size();
     const T* h[3] = {&history_[(newest_ + 1) % 3 * C * S], &history_[(newest_ + 2) % 3 * C * S],
                      &history_[newest_ * C * S]};  // t_{n-1}, t_n, t_{n+1}
-    // BGK rescales and collides each population alone: the opposites' channels are not read.
-    constexpr int channels = std::is_same_v<Op, collision::Bgk> ? D + 1 + E : C;
+    constexpr int channels = kept_channels<Op>;
     const std::array<T*, Q> P = fine.bases();
     // Scratch per thread, sized once (and again only if more threads run than before).
     const std::size_t threads = static_cast<std::size_t>(omp_get_max_threads());
@@ -260,8 +265,8 @@ class TwoLevel {
   void collide_ghosts(const T (&coarse_c)[C][batch], const std::array<T*, Q>& P, const Op& op,
                       std::ptrdiff_t k0) const {
     constexpr std::array<int, 2 * E> pops = channel_populations(Face);
-    constexpr bool split = !std::is_same_v<Op, collision::Bgk>;  // even and odd parts apart
-    const T s_plus = T(f_from_c_.plus), s_minus = T(f_from_c_.minus);
+    constexpr int kept = kept_channels<Op> - (D + 1);  // 2E, or E without the opposites (BGK)
+    const T half_plus = T(0.5 * f_from_c_.plus), half_minus = T(0.5 * f_from_c_.minus);
     T post[Q][batch];
 #pragma omp simd
     for (int b = 0; b < batch; ++b) {
@@ -272,16 +277,12 @@ class TwoLevel {
       collision::equilibrium<L, T>(rho, u, feq);
 #pragma GCC unroll 19
       for (int i = 0; i < Q; ++i) f[i] = feq[i];  // the populations no channel keeps: unused
-      T neq[2 * E];
+      T neq[2 * E] = {};  // without the opposites' channels their part is 0: s+ = s− for BGK
 #pragma GCC unroll 10
-      for (int e = 0; e < (split ? 2 * E : E); ++e) neq[e] = coarse_c[D + 1 + e][b] - feq[pops[e]];
-      // f ← f_eq + s+ (even part of f_neq) + s− (odd part), the rescaling to the fine block.
+      for (int e = 0; e < kept; ++e) neq[e] = coarse_c[D + 1 + e][b] - feq[pops[e]];
 #pragma GCC unroll 10
-      for (int e = 0; e < (split ? 2 * E : E); ++e) {
-        const int o = e < E ? e + E : e - E;
-        f[pops[e]] = split ? feq[pops[e]] + T(0.5) * s_plus * (neq[e] + neq[o]) + T(0.5) * s_minus * (neq[e] - neq[o])
-                           : feq[pops[e]] + s_plus * neq[e];
-      }
+      for (int e = 0; e < kept; ++e)
+        f[pops[e]] = rescaled(feq[pops[e]], neq[e], neq[e < E ? e + E : e - E], half_plus, half_minus);
       op.template collide<L, T>(f, feq, out);
 #pragma GCC unroll 19
       for (int i = 0; i < Q; ++i)
@@ -357,22 +358,26 @@ class TwoLevel {
     }
   };
 
+  /// One population rescaled between the blocks: f_eq + s+ · (even part of f_neq) + s− · (odd
+  /// part), from its f_neq and its opposite's, with half_± = s±/2.
+  [[gnu::always_inline]] static T rescaled(T feq, T neq, T neq_opposite, T half_plus, T half_minus) {
+    return feq + half_plus * (neq + neq_opposite) + half_minus * (neq - neq_opposite);
+  }
+
   /// f ← f_eq + s+ · (even part of f_neq) + s− · (odd part of f_neq), with feq the equilibrium
   /// of f's moments (which the rescaling keeps).
   static void rescale_non_equilibrium(T (&f)[Q], T (&feq)[Q], const Taus& s) {
     T rho, u[D];
     collision::moments<L, T>(f, rho, u);
     collision::equilibrium<L, T>(rho, u, feq);
-    // Unrolled: inside the `omp simd` loops of collide_ghosts and restrict_nodes an inner loop
-    // stops GCC from vectorising over the nodes.
+    // Unrolled: inside the `omp simd` loop of restrict_nodes an inner loop stops GCC from
+    // vectorising over the nodes.
     T neq[Q];
 #pragma GCC unroll 19
     for (int i = 0; i < Q; ++i) neq[i] = f[i] - feq[i];
+    const T half_plus = T(0.5 * s.plus), half_minus = T(0.5 * s.minus);
 #pragma GCC unroll 19
-    for (int i = 0; i < Q; ++i) {
-      const int o = L::opposite[i];
-      f[i] = feq[i] + T(0.5 * s.plus) * (neq[i] + neq[o]) + T(0.5 * s.minus) * (neq[i] - neq[o]);
-    }
+    for (int i = 0; i < Q; ++i) f[i] = rescaled(feq[i], neq[i], neq[L::opposite[i]], half_plus, half_minus);
   }
 
   /// Coarse index of a fine position, as twice the coordinate (odd = half way between nodes).
@@ -561,7 +566,9 @@ class TwoLevel {
     }
   }
 
-  /// The channels of every face's plane nodes at the coarse block's current time level.
+  /// The first `Channels` channels of every face's plane nodes at the coarse block's current
+  /// time level.
+  template <int Channels>
   void store_level(const field::Populations<L, T>& coarse, int level) {
     const std::size_t S = sources_.size();
     const std::array<const T*, Q> P = coarse.bases();
@@ -578,7 +585,7 @@ class TwoLevel {
         collision::shifted_density_momentum<L, T>(f, drho, j);
         out[k] = drho;
         for (int a = 0; a < D; ++a) out[(1 + a) * S + k] = j[a];
-        for (int e = 0; e < 2 * E; ++e) out[(D + 1 + e) * S + k] = f[pops[e]];
+        for (int e = 0; e < Channels - (D + 1); ++e) out[(D + 1 + e) * S + k] = f[pops[e]];
       }
     }
   }

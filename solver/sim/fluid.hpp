@@ -85,7 +85,7 @@ class Fluid {
       const auto& g = blk.pop.grid();
       collision::initialise_equilibrium(blk.pop, [&](const Index<D>& ijk) { return init(g.position(ijk)); });
     }
-    if (two_level()) coupling_.capture_coarse(blocks_[0].pop);
+    if (two_level()) coupling_.template capture_coarse<Op>(blocks_[0].pop);
   }
 
   /// One coarse time step (and m = 2 fine substeps). `hook` forces the finest block;
@@ -113,7 +113,7 @@ class Fluid {
       });
     };
     advance_block(c, {}, coarse_and_band_before, coarse_after);
-    core::timed(coupling_seconds_, [&] { coupling_.capture_coarse(c.pop); });
+    core::timed(coupling_seconds_, [&] { coupling_.template capture_coarse<Op>(c.pop); });
     for (int sub = 0; sub < 2; ++sub) {
       advance_block(f, hook, [] {}, [&] {
         core::timed(coupling_seconds_, [&] { coupling_.fill_fine_ghosts(f.pop, f.op, 0.5 * sub); });
