@@ -566,6 +566,10 @@ class TwoLevel {
     }
   }
 
+  /// Plane nodes ahead whose Q values store_level prefetches. Within the step the coarse planes
+  /// are cold and each node of an x-normal face reads Q cache lines; the loads' misses, not the
+  /// bandwidth, set its time (solver/bench/NOTES.md, "The capture prefetches its plane nodes").
+  static constexpr std::size_t capture_ahead = 8;
   /// The first `Channels` channels of every face's plane nodes at the coarse block's current
   /// time level.
   template <int Channels>
@@ -580,6 +584,8 @@ class TwoLevel {
       const std::size_t last = face + 1 < 2 * D ? faces_[face + 1].first_source : S;
 #pragma omp for schedule(static) nowait
       for (std::size_t k = first; k < last; ++k) {
+        if (k + capture_ahead < last)
+          for (int i = 0; i < Q; ++i) __builtin_prefetch(P[i] + sources_[k + capture_ahead], 0, 3);
         T f[Q], drho, j[D];
         for (int i = 0; i < Q; ++i) f[i] = P[i][sources_[k]];
         collision::shifted_density_momentum<L, T>(f, drho, j);
