@@ -90,7 +90,7 @@ template <bool Forced, class L, class T, class Op>
 /// eq. 2.25: what the forced collision uses and the IB's markers move with), as up[a][n].
 template <class L, class T>
 [[gnu::always_inline]] inline void store_forced_velocity(const T (&f)[L::q], const double* const (&fp)[L::d],
-                                                         double* const* up, std::ptrdiff_t n) {
+                                                         double* const* up, std::ptrdiff_t n, bool store = true) {
   double fd[L::q], rho, j[L::d];
 #pragma GCC unroll 19
   for (int i = 0; i < L::q; ++i) fd[i] = f[i];
@@ -98,7 +98,8 @@ template <class L, class T>
   const double inv_rho = 1.0 / rho;
   // An explicit fma: GCC contracts j * inv_rho + ... or not depending on the code around it,
   // and the sweep's velocity must equal forced_velocity_at's bit for bit.
-  for (int a = 0; a < L::d; ++a) up[a][n] = std::fma(j[a], inv_rho, fp[a][n] / (2.0 * rho));
+  if (store)
+    for (int a = 0; a < L::d; ++a) up[a][n] = std::fma(j[a], inv_rho, fp[a][n] / (2.0 * rho));
 }
 
 /// Collide-and-push of node n in place (the body of the fused kernel's vector loop): reads
@@ -106,21 +107,23 @@ template <class L, class T>
 /// same Q slots, and where the next step at the other parity finds it at node n + c_i).
 /// With Velocity (forced only), also the node's velocity before the collision into up
 /// (store_forced_velocity). Scalars and references to C arrays only, so that GCC vectorizes
-/// the loop that calls it.
+/// the loop that calls it. With `store` false the node is computed and nothing is written
+/// (the idle lanes of update_tail).
 template <bool Forced, class L, class T, bool Velocity = false, class Op>
 [[gnu::always_inline]] inline void update_node(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
-                                               std::ptrdiff_t n, double* const* up = nullptr) {
+                                               std::ptrdiff_t n, double* const* up = nullptr, bool store = true) {
   static_assert(Forced || !Velocity, "the velocity with the force is the forced kernel's");
   constexpr int Q = L::q, D = L::d;
   T f[Q], F[D], out[Q];
 #pragma GCC unroll 19
   for (int i = 0; i < Q; ++i) f[i] = P[i][n];
-  if constexpr (Velocity) store_forced_velocity<L, T>(f, fp, up, n);
+  if constexpr (Velocity) store_forced_velocity<L, T>(f, fp, up, n, store);
   if constexpr (Forced)
     for (int a = 0; a < D; ++a) F[a] = T(fp[a][n]);
   collide_node<Forced, L, T>(f, F, op, out);
+  if (store)
 #pragma GCC unroll 19
-  for (int i = 0; i < Q; ++i) P[L::opposite[i]][n] = out[i];
+    for (int i = 0; i < Q; ++i) P[L::opposite[i]][n] = out[i];
 }
 
 /// Updates the `rem` (< 2w) nodes from `at` as pieces of w, w/2, …, 1 consecutive nodes, each a
@@ -140,8 +143,25 @@ template <int w, bool Forced, class L, class T, bool Velocity = false, class Op>
   }
 }
 
+/// Updates the `rem` (< W) nodes from `at` as one vector chunk of W lanes whose lanes from `rem`
+/// on load and compute but store nothing (masked stores). Their loads reach the next W − rem
+/// nodes of the buffer (the ghost layer or the next row; inside the buffer): values that are
+/// discarded, whoever updates those nodes. Out of line and flattened, as update_pieces.
+template <bool Forced, class L, class T, bool Velocity = false, class Op>
+[[gnu::noinline, gnu::flatten]] void update_tail(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
+                                               std::ptrdiff_t at, int rem, double* const* up = nullptr) {
+  constexpr int W = simd_chunk<T>;
+#pragma omp simd
+  for (int x = 0; x < W; ++x) update_node<Forced, L, T, Velocity>(P, op, fp, at + x, up, x < rem);
+}
+
 /// Updates the n consecutive nodes from `at`: whole vector chunks, prefetching ahead, then the
-/// pieces of the rest.
+/// rest: in single precision (16 lanes) one masked chunk (update_tail), in double (8 lanes)
+/// pieces (update_pieces). Measured, the rate of an n^3 periodic box over that of an (n + 1)^3
+/// box in the same process, D3Q19 BGK, 2 threads, AMD EPYC (solver/bench/NOTES.md, "The row's
+/// end"): single 47^3 0.65 with pieces, 0.86 masked; 127^3 0.79-0.81 -> 0.94-0.96; double
+/// 47^3 0.85-0.86 with pieces, 0.69-0.70 masked. Pieces of 8, 4, 2, 1 float lanes are four
+/// passes, down to scalar code; of 4, 2, 1 double lanes about one chunk's work.
 template <bool Forced, class L, class T, bool Velocity = false, class Op>
 [[gnu::always_inline]] inline void update_run(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
                                               std::ptrdiff_t at, int n, double* const* up = nullptr) {
@@ -155,7 +175,11 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
 #pragma omp simd
     for (int x = 0; x < W; ++x) update_node<Forced, L, T, Velocity>(P, op, fp, chunk + x, up);
   }
-  update_pieces<W / 2, Forced, L, T, Velocity>(P, op, fp, at + whole, n - whole, up);
+  if constexpr (W >= 16) {
+    if (whole < n) update_tail<Forced, L, T, Velocity>(P, op, fp, at + whole, n - whole, up);
+  } else {
+    update_pieces<W / 2, Forced, L, T, Velocity>(P, op, fp, at + whole, n - whole, up);
+  }
 }
 
 /// The in-place sweep of one time step over the interior of a block, without the parity flip
@@ -164,7 +188,7 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
 ///
 /// Each row runs in chunks of simd_chunk<T> nodes with a trip count known at compile time, so
 /// the whole row is vector code, and the rest of the row in pieces of half, a quarter … of a
-/// chunk (update_pieces). (A row of 47 nodes, the fine block of a chapter 5 sphere, otherwise
+/// chunk (update_pieces) or one masked chunk (update_tail; see update_run). (A row of 47 nodes, the fine block of a chapter 5 sphere, otherwise
 /// ends in a 15-node scalar remainder: measured 51 MLUPS at 47^3 against 128 at 48^3, D3Q19 TRT
 /// single, 2 threads, A–B pattern.) The A–B kernel instead redid a few nodes in a last chunk
 /// shifted back to end at the row's end; in place a node must not be updated twice, and the

@@ -21,7 +21,8 @@
 // bases[i][t] of the new parity is also where population i *entering* interior node t from a
 // ghost belongs, and bases[i][g] for a ghost g = s + c_i where interior node s put the
 // population i that *left* it: the boundary and coupling stages fill the first from the second.
-// Only slots reached that way are addressed (base(i) + n stays inside the buffer).
+// Only slots reached that way are addressed (base(i) + n stays inside the buffer), and the
+// loads of the fused kernel's idle lanes, at most one chunk past them (the buffer's `slack`).
 //
 // Each population's array holds stride(N) ≥ N values for the N nodes of the grid: a whole,
 // odd number of 64-byte lines, so that the Q arrays start in Q different sets of a 4 KiB
@@ -52,7 +53,7 @@ class Populations {
 
   Populations() = default;
   explicit Populations(const Grid<D>& grid) : grid_(grid) {
-    buf_.assign(static_cast<std::size_t>(Q) * stride(grid.size()), T(0));
+    buf_.assign(static_cast<std::size_t>(Q) * stride(grid.size()) + slack, T(0));
     for (int i = 0; i < Q; ++i) off_[i] = grid.offset(L::c[i]);
   }
 
@@ -100,7 +101,7 @@ class Populations {
       throw core::Error("checkpoint: " + prefix + " holds " + std::to_string(s) +
                         " values per population, this build " + std::to_string(stride(grid_.size())) +
                         ": resume it with the build that wrote it or run afresh");
-    ar(prefix + "populations_in_place", std::span<T>(buf_));
+    ar(prefix + "populations_in_place", std::span<T>(buf_.data(), buf_.size() - slack));
     ar(prefix + "parity", parity_);
   }
 
@@ -122,6 +123,10 @@ class Populations {
   static std::ptrdiff_t base(std::ptrdiff_t S, int p, int i, std::ptrdiff_t off_i) {
     return p == 0 ? i * S : L::opposite[i] * S - off_i;
   }
+
+  /// Values after the last population's array: the idle lanes of the fused kernel's last
+  /// chunk of a row (collision::update_tail) load up to one chunk past the last slot addressed.
+  static constexpr std::size_t slack = 64 / sizeof(T);
 
   Grid<D> grid_;
   AlignedVector<T> buf_;
