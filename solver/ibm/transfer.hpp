@@ -91,15 +91,23 @@ class Transfer {
     const std::ptrdiff_t m_count = static_cast<std::ptrdiff_t>(positions.size());
     x_lu_.resize(m_count);
     stencil_.resize(m_count);
+    first_plane_.resize(m_count);
     std::ptrdiff_t first_bad = m_count;
-#pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold) reduction(min : first_bad)
+    int lo = grid_.n()[D - 1], hi = -1;  // the planes the stencils reach
+#pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold) \
+    reduction(min : first_bad, lo) reduction(max : hi)
     for (std::ptrdiff_t m = 0; m < m_count; ++m) {
       x_lu_[m] = grid_.to_lattice(positions[m]);
       if (!fill_stencil(m) && m < first_bad) first_bad = m;
+      const auto& planes = stencil_[m].i[D - 1];
+      first_plane_[m] = planes[0];
+      for (int k = 0; k < support; ++k) lo = std::min(lo, planes[k]), hi = std::max(hi, planes[k]);
     }
     if (first_bad < m_count)
       core::check_failed("stencil inside block", __FILE__, __LINE__,
                          stencil_error(first_bad, positions[first_bad]));
+    plane_lo_ = lo;
+    plane_hi_ = hi;
     sort_by_plane();
   }
 
@@ -349,10 +357,12 @@ class Transfer {
 
   // order_ = the markers sorted stably by the plane of their first stencil node along the last
   // axis (a counting sort); plane p holds order_[plane_start_[p] .. plane_start_[p + 1]).
+  // Serial: it reads the planes from first_plane_ (4 bytes a marker) rather than the stencils
+  // (a cache line and more each): the other thread waits meanwhile (solver/bench/NOTES.md).
   void sort_by_plane() {
     const int n = grid_.n()[D - 1];
     const std::size_t m_count = marker_count();
-    auto plane_of = [&](std::size_t m) { return stencil_[m].i[D - 1][0]; };
+    auto plane_of = [&](std::size_t m) { return first_plane_[m]; };
     plane_start_.assign(n + 1, 0);
     order_.resize(m_count);
     for (std::size_t m = 0; m < m_count; ++m) ++plane_start_[plane_of(m) + 1];
@@ -365,13 +375,6 @@ class Transfer {
     for (int p = 0; p < n; ++p)
       plane_load_[p + 1] =
           plane_load_[p] + (plane_start_[p + 1] - plane_start_[std::max(0, p - support + 1)]);
-    plane_lo_ = n;
-    plane_hi_ = -1;
-    for (std::size_t m = 0; m < m_count; ++m)
-      for (int k = 0; k < support; ++k) {
-        plane_lo_ = std::min(plane_lo_, stencil_[m].i[D - 1][k]);
-        plane_hi_ = std::max(plane_hi_, stencil_[m].i[D - 1][k]);
-      }
   }
 
   std::string stencil_error(std::ptrdiff_t m, const Vec<D>& x_phys) const {
@@ -416,6 +419,7 @@ class Transfer {
   std::vector<Stencil> stencil_;
   // The markers by the plane their stencil starts in, and what the threads split (sort_by_plane).
   std::vector<std::size_t> plane_start_, order_, plane_load_;
+  std::vector<int> first_plane_;  // per marker: the plane of its stencil's first node (update)
   int plane_lo_ = 0, plane_hi_ = -1;  // the planes the stencils reach
 };
 
