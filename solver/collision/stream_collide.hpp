@@ -159,7 +159,7 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
 /// rest: in single precision (16 lanes) one masked chunk (update_tail), in double (8 lanes)
 /// pieces (update_pieces). Measured, the rate of an n^3 periodic box over that of an (n + 1)^3
 /// box in the same process, D3Q19 BGK, 2 threads, AMD EPYC (solver/bench/NOTES.md, "The row's
-/// end"): single 47^3 0.65 with pieces, 0.86 masked; 127^3 0.79-0.81 -> 0.94-0.96; double
+/// end"): single 47^3 0.65 with pieces, 0.85-0.95 masked; 127^3 0.79-0.81 -> 0.94-0.96; double
 /// 47^3 0.85-0.86 with pieces, 0.69-0.70 masked. Pieces of 8, 4, 2, 1 float lanes are four
 /// passes, down to scalar code; of 4, 2, 1 double lanes about one chunk's work.
 template <bool Forced, class L, class T, bool Velocity = false, class Op>
@@ -188,13 +188,14 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
 ///
 /// Each row runs in chunks of simd_chunk<T> nodes with a trip count known at compile time, so
 /// the whole row is vector code, and the rest of the row in pieces of half, a quarter … of a
-/// chunk (update_pieces) or one masked chunk (update_tail; see update_run). (A row of 47 nodes, the fine block of a chapter 5 sphere, otherwise
-/// ends in a 15-node scalar remainder: measured 51 MLUPS at 47^3 against 128 at 48^3, D3Q19 TRT
-/// single, 2 threads, A–B pattern.) The A–B kernel instead redid a few nodes in a last chunk
-/// shifted back to end at the row's end; in place a node must not be updated twice, and the
-/// shifted chunk with the overlapping lanes blended back was slow: its loads partly overlap the
-/// stores of the chunk before (measured 47^3 D3Q19 BGK, 2 threads: double 136, float 106 MLUPS
-/// against 208 / 353 at 48^3; with the shifted chunk first, 87 / 59).
+/// chunk (update_pieces) or as one masked chunk (update_tail; see update_run). (A row of 47
+/// nodes, the fine block of a chapter 5 sphere, otherwise ends in a 15-node scalar remainder:
+/// measured 51 MLUPS at 47^3 against 128 at 48^3, D3Q19 TRT single, 2 threads, A–B pattern.)
+/// The A–B kernel instead redid a few nodes in a last chunk shifted back to end at the row's
+/// end; in place a node must not be updated twice, and the shifted chunk with the overlapping
+/// lanes blended back was slow: its loads partly overlap the stores of the chunk before
+/// (measured 47^3 D3Q19 BGK, 2 threads: double 136, float 106 MLUPS against 208 / 353 at 48^3;
+/// with the shifted chunk first, 87 / 59).
 template <bool Forced, class L, class T, class Op>
 void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>* force,
            const field::Box<L::d>& skip = {}) {
