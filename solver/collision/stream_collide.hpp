@@ -155,6 +155,20 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
   for (int x = 0; x < W; ++x) update_node<Forced, L, T, Velocity>(P, op, fp, at + x, up, x < rem);
 }
 
+/// The first x of the fused kernel's row runs (the x0 of sweep) on a block of nx nodes per row
+/// whose ghost layer nothing reads: −1 where the ghost before each row makes the runs whole
+/// chunks (nx + 1 a multiple of simd_chunk<T>, as for the fine blocks of 2k − 1 nodes), else 0.
+/// Updating a ghost writes only the slots it owns (field/populations.hpp): those that enter the
+/// interior, which the stage after the sweep overwrites (the two-level fill), and slots of the
+/// ghost layer, which no interior node reads. The ghost's values are not a flow state and may
+/// grow without bound; nothing reads them. Measured on the 128^3 bench box's 127^3 fine block:
+/// solver/bench/NOTES.md, "The fine rows start at their ghost".
+template <class T>
+constexpr int ghost_row_start(int nx) {
+  constexpr int W = simd_chunk<T>;
+  return nx % W != 0 && (nx + 1) % W == 0 ? -1 : 0;
+}
+
 /// Updates the n consecutive nodes from `at`: whole vector chunks, prefetching ahead, then the
 /// rest: in single precision (16 lanes) one masked chunk (update_tail), in double (8 lanes)
 /// pieces (update_pieces). Measured, the rate of an n^3 periodic box over that of an (n + 1)^3
@@ -196,9 +210,11 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
 /// lanes blended back was slow: its loads partly overlap the stores of the chunk before
 /// (measured 47^3 D3Q19 BGK, 2 threads: double 136, float 106 MLUPS against 208 / 353 at 48^3;
 /// with the shifted chunk first, 87 / 59).
+///
+/// With x0 = −1 each row's run starts at the ghost before the row (see ghost_row_start).
 template <bool Forced, class L, class T, class Op>
 void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField<L::d, double>* force,
-           const field::Box<L::d>& skip = {}) {
+           const field::Box<L::d>& skip = {}, int x0 = 0) {
   constexpr int Q = L::q, D = L::d;
   const auto& g = pop.grid();
   const std::array<T*, Q> P = pop.bases();
@@ -216,10 +232,10 @@ void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField
     const double* fp_l[D];
     for (int a = 0; a < D; ++a) fp_l[a] = fp[a];
     if (skip.crosses_row(row)) {
-      update_run<Forced, L, T>(P_l, op_l, fp_l, base, skip.lo[0]);
+      update_run<Forced, L, T>(P_l, op_l, fp_l, base + x0, skip.lo[0] - x0);
       update_run<Forced, L, T>(P_l, op_l, fp_l, base + skip.hi[0], nx - skip.hi[0]);
     } else {
-      update_run<Forced, L, T>(P_l, op_l, fp_l, base, nx);
+      update_run<Forced, L, T>(P_l, op_l, fp_l, base + x0, nx - x0);
     }
   });
 }
@@ -230,8 +246,9 @@ void sweep(field::Populations<L, T>& pop, const Op& op, const field::VectorField
 /// `force` (lattice units, per node) must be non-null exactly when Forced is true.
 template <bool Forced, class L, class T, class Op>
 void stream_collide(field::Populations<L, T>& pop, const Op& op,
-                    const field::VectorField<L::d, double>* force = nullptr, const field::Box<L::d>& skip = {}) {
-  sweep<Forced>(pop, op, force, skip);
+                    const field::VectorField<L::d, double>* force = nullptr, const field::Box<L::d>& skip = {},
+                    int x0 = 0) {
+  sweep<Forced>(pop, op, force, skip, x0);
   pop.flip_parity();
 }
 
@@ -360,9 +377,11 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
 /// samples, solver/bench/NOTES.md). (Before, the region was collided into scratch ahead of an
 /// unforced sweep of the whole block and copied over its results: with the region's nodes
 /// swept twice and the copy, 9 % of a chapter 5 sphere's step, solver/bench/NOTES.md.)
+/// x0 as in sweep().
 template <class L, class T, class Op>
 void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op,
-                              const field::VectorField<L::d, double>& force, const ForcedRegion& region) {
+                              const field::VectorField<L::d, double>& force, const ForcedRegion& region,
+                              int x0 = 0) {
   constexpr int Q = L::q, D = L::d;
   const auto& g = pop.grid();
   const std::array<T*, Q> P = pop.bases();
@@ -393,7 +412,7 @@ void stream_collide_forced_at(field::Populations<L, T>& pop, const Op& op,
       else
         hi = mid;
     }
-    std::ptrdiff_t at = base;
+    std::ptrdiff_t at = base + x0;
     for (std::ptrdiff_t k = lo; k < count && begin_of(k) < row_end; ++k) {
       const std::ptrdiff_t b = begin_of(k), e = end_of(k);
       update_stretch<false, L, T>(P_l, op_l, fp_l, at, static_cast<int>(b - at));

@@ -41,6 +41,7 @@ class Fluid {
     Force force;          // allocated when the block is ever forced
     bool has_body_force = false;
     field::Box<D> skip;  // nodes its sweep leaves alone: the covered nodes of a coarse block
+    int row_start = 0;   // the sweep's x0: −1 on a fine block (collision::ghost_row_start)
   };
 
   struct Setup {
@@ -63,6 +64,8 @@ class Fluid {
       coupling_ = refinement::TwoLevel<L, T>(s.coarse, *s.fine, {s.coarse_op.tau, s.coarse_op.tau_minus()},
                                              {fine_op.tau, fine_op.tau_minus()});
       blocks_[0].skip = coupling_.idle_coarse();
+      // Nothing reads the fine block's ghost layer: the fill overwrites what its ghosts push in.
+      blocks_[1].row_start = collision::ghost_row_start<T>(s.fine->n()[0]);
     }
     coarse_bc_ = boundary::BoundarySet<L, T>(s.coarse, s.boundaries, s.imposed_velocity_lu, s.far_field);
     const bool body = s.body_force_lu.norm() > 0;
@@ -174,11 +177,11 @@ class Fluid {
     before_sweep();
     if (blk.has_body_force) {
       if (forced.wants_velocity()) collision::forced_velocity_at(blk.pop, blk.force, forced);
-      collision::stream_collide<true>(blk.pop, blk.op, &blk.force, blk.skip);
+      collision::stream_collide<true>(blk.pop, blk.op, &blk.force, blk.skip, blk.row_start);
     } else if (!forced.empty()) {
-      collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced);
+      collision::stream_collide_forced_at(blk.pop, blk.op, blk.force, forced, blk.row_start);
     } else {
-      collision::stream_collide<false>(blk.pop, blk.op, nullptr, blk.skip);
+      collision::stream_collide<false>(blk.pop, blk.op, nullptr, blk.skip, blk.row_start);
     }
     apply_boundaries();
   }
