@@ -157,7 +157,7 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
 
 /// The first x of the fused kernel's row runs (the x0 of sweep) on a block of nx nodes per row
 /// whose ghost layer nothing reads: −1 where the ghost before each row makes the runs whole
-/// chunks (nx + 1 a multiple of simd_chunk<T>, as for the fine blocks of 2k − 1 nodes), else 0.
+/// chunks (nx + 1 a multiple of simd_chunk<T>, as for fine blocks of 47 or 127 nodes), else 0.
 /// Updating a ghost writes only the slots it owns (field/populations.hpp): those that enter the
 /// interior, which the stage after the sweep overwrites (the two-level fill), and slots of the
 /// ghost layer, which no interior node reads. The ghost's values are not a flow state and may
@@ -165,8 +165,7 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
 /// solver/bench/NOTES.md, "The fine rows start at their ghost".
 template <class T>
 constexpr int ghost_row_start(int nx) {
-  constexpr int W = simd_chunk<T>;
-  return nx % W != 0 && (nx + 1) % W == 0 ? -1 : 0;
+  return (nx + 1) % simd_chunk<T> == 0 ? -1 : 0;
 }
 
 /// Updates the n consecutive nodes from `at`: whole vector chunks, prefetching ahead, then the
