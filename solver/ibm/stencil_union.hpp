@@ -3,98 +3,115 @@
 // The forced collision (with the velocity the capsules move with) runs on the nodes that some
 // stencil touches.
 // Stencils overlap heavily (a 3D capsule of 4098 markers has 262k stencil entries, many times
-// its distinct nodes), so the union is marked in byte masks over the block and read back over
-// the range the stencils span (a sort of the entries cost as much as spreading).
-// A stencil row along axis 0 is `run` consecutive linear indices unless it wraps around a
-// periodic axis 0. Rows that do not wrap are marked once, at their first node, in
-// `run_start_`, and the read-back extends each start over `run` nodes; the nodes of rows that
-// wrap go one by one into `single_`. One store per row instead of per node (measured: the
-// per-node stores were 6 % of a chapter 6 biconcave step; solver/bench/NOTES.md).
+// its distinct nodes), so the union is marked in a bit mask and read back in order (a sort of
+// the entries cost as much as spreading). The mask holds one bit per interior node, a row
+// along axis 0 in whole 64-bit words: a stencil row of `support` consecutive nodes is one or
+// two OR operations, and the mask of a chapter 5 fine block (47^3) is 18 KB, so marking stays
+// in the first-level cache. (Byte masks over the whole block, one byte per row start, cost
+// twice the marking and a serial read-back of the block's bytes: solver/bench/NOTES.md.)
 //
-// Threads: mark_run and mark_node store 1 with relaxed atomic stores, so concurrent marking
-// (every thread writes the same value) is race-free; widen and collect are serial.
-// Invariant: both masks are all zero between collect() calls.
+// Threads: marking is not atomic. The transfers mark in parallel over ranges of planes
+// (Transfer::mark_stencil_nodes): a thread writes only the rows of its own planes, so no two
+// threads write one word. collect() reads back in parallel over ranges of rows.
+// Invariant: the mask is all zero between collect() calls.
 #pragma once
 
+#include <omp.h>
+
 #include <algorithm>
-#include <atomic>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <vector>
+
+#include "field/grid.hpp"
 
 namespace caplab::ibm {
 
 class StencilUnion {
  public:
-  /// Prepares the masks for a block of `grid_size` linear indices.
-  void begin(std::ptrdiff_t grid_size) {
-    if (static_cast<std::ptrdiff_t>(run_start_.size()) != grid_size) {
-      run_start_.assign(grid_size, 0);
-      single_.assign(grid_size, 0);
+  /// Prepares the mask for the interior nodes of `grid`. A row is an interior line along axis 0,
+  /// numbered row_of(i1, i2) (3D) or i1 (2D).
+  template <int D>
+  void begin(const field::Grid<D>& grid) {
+    const std::ptrdiff_t rows = grid.interior_size() / grid.n()[0];
+    const int words = (grid.n()[0] + 63) / 64;
+    if (rows != rows_ || words != words_) {
+      rows_ = rows;
+      words_ = words;
+      bits_.assign(static_cast<std::size_t>(rows * words), 0);
     }
-    run_ = 0;
-    lo_ = grid_size;
+    rows_per_plane_ = D == 3 ? grid.n()[1] : 1;
+    row_stride_ = D == 3 ? grid.stride(1) : 0;
+    plane_stride_ = grid.stride(D - 1);
+    lo_ = rows_;
     hi_ = -1;
   }
-  /// Whether rows of `length` nodes can be marked with mark_run: the first length asked for
-  /// after begin() is the run length (all transfers of a scene share one kernel; another
-  /// length marks node by node). Serial.
-  bool runs_of(int length) {
-    if (run_ == 0) run_ = length;
-    return run_ == length;
-  }
 
-  /// Marks the nodes first .. first + run - 1 (after runs_of(run) was true).
-  void mark_run(std::ptrdiff_t first) { store_one(run_start_[first]); }
-  /// Marks node n.
-  void mark_node(std::ptrdiff_t n) { store_one(single_[n]); }
-  /// The marked nodes lie in [lo, hi]: every marking pass widens the range once, with the
-  /// bounds of what it marked (not thread-safe: call it outside parallel regions).
+  /// The row of interior node (., i1, i2) in 3D.
+  std::ptrdiff_t row_of(int i1, int i2) const { return i1 + static_cast<std::ptrdiff_t>(rows_per_plane_) * i2; }
+  /// The rows of plane p (the index along the last axis): [p, p + 1) * rows_per_plane.
+  std::ptrdiff_t rows_per_plane() const { return rows_per_plane_; }
+
+  /// Marks the `length` (at most 64) nodes x0 .. x0 + length - 1 of `row`.
+  void mark_run(std::ptrdiff_t row, int x0, int length) {
+    std::uint64_t* w = &bits_[row * words_ + (x0 >> 6)];
+    const int b = x0 & 63;
+    const std::uint64_t run = length == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << length) - 1;
+    w[0] |= run << b;
+    if (b + length > 64) w[1] |= run >> (64 - b);
+  }
+  /// Marks node x of `row`.
+  void mark_node(std::ptrdiff_t row, int x) { bits_[row * words_ + (x >> 6)] |= std::uint64_t(1) << (x & 63); }
+  /// The marked nodes lie in the rows [lo, hi]: every marking pass widens the range once, with
+  /// the bounds of what it marked (not thread-safe: call it outside parallel regions).
   void widen(std::ptrdiff_t lo, std::ptrdiff_t hi) {
-    lo_ = std::min(lo_, lo);
-    hi_ = std::max(hi_, hi);
+    lo_ = std::min(lo_, std::max<std::ptrdiff_t>(lo, 0));
+    hi_ = std::max(hi_, std::min(hi, rows_ - 1));
   }
 
-  /// Appends every marked node to `nodes` in increasing order and clears the marks. Where no
-  /// run covers it, the range is read 8 bytes of both masks at a time: most of it (whole planes
-  /// across the block around a capsule) holds no mark.
+  /// Sets `nodes` to every marked node's linear index (field::Grid::index) in increasing order and
+  /// clears the mask. In parallel over ranges of rows: each thread counts its marks, then writes
+  /// them at its offset.
   void collect(std::vector<std::ptrdiff_t>& nodes) {
-    int left = 0;  // nodes still covered by the last run start
-    for (std::ptrdiff_t n = lo_; n <= hi_;) {
-      if (left == 0 && n + 8 <= hi_ + 1 && !any_mark_in_8(n)) {
-        n += 8;
-        continue;
+    nodes.clear();
+    if (hi_ < lo_) return;
+    const std::ptrdiff_t rows = hi_ - lo_ + 1;
+#pragma omp parallel if (rows * words_ > 4096)
+    {
+      const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+#pragma omp single
+      counts_.assign(threads + 1, 0);
+      const std::ptrdiff_t first = lo_ + rows * t / threads, last = lo_ + rows * (t + 1) / threads;
+      std::size_t count = 0;
+      for (std::ptrdiff_t w = first * words_; w < last * words_; ++w) count += std::popcount(bits_[w]);
+      counts_[t + 1] = count;
+#pragma omp barrier
+#pragma omp single
+      {
+        for (int k = 0; k < threads; ++k) counts_[k + 1] += counts_[k];
+        nodes.resize(counts_[threads]);
       }
-      if (run_start_[n]) {
-        left = run_;
-        run_start_[n] = 0;
+      std::ptrdiff_t* out = nodes.data() + counts_[t];
+      for (std::ptrdiff_t r = first; r < last; ++r) {
+        std::uint64_t* w = &bits_[r * words_];
+        const std::ptrdiff_t base = 1 + (r % rows_per_plane_ + 1) * row_stride_ + (r / rows_per_plane_ + 1) * plane_stride_;
+        for (int k = 0; k < words_; ++k) {
+          for (std::uint64_t b = w[k]; b != 0; b &= b - 1) *out++ = base + 64 * k + std::countr_zero(b);
+          w[k] = 0;
+        }
       }
-      if (single_[n]) {
-        single_[n] = 0;
-        nodes.push_back(n);
-      } else if (left > 0) {
-        nodes.push_back(n);
-      }
-      if (left > 0) --left;
-      ++n;
     }
   }
 
  private:
-  bool any_mark_in_8(std::ptrdiff_t n) const {
-    std::uint64_t a, b;
-    std::memcpy(&a, &run_start_[n], 8);
-    std::memcpy(&b, &single_[n], 8);
-    return (a | b) != 0;
-  }
-  static void store_one(std::uint8_t& b) {
-    std::atomic_ref<std::uint8_t>(b).store(1, std::memory_order_relaxed);
-  }
-
-  std::vector<std::uint8_t> run_start_, single_;
-  int run_ = 0;  // 0: not chosen yet
-  std::ptrdiff_t lo_ = 0, hi_ = -1;
+  std::vector<std::uint64_t> bits_;  // rows_ x words_
+  std::vector<std::size_t> counts_;  // collect(): the threads' offsets
+  std::ptrdiff_t rows_ = 0;
+  int words_ = 0;
+  int rows_per_plane_ = 1;
+  std::ptrdiff_t row_stride_ = 0, plane_stride_ = 0;  // linear index = 1 + x + (i1 + 1) row_stride + (p + 1) plane_stride
+  std::ptrdiff_t lo_ = 0, hi_ = -1;                    // the rows marked
 };
 
 }  // namespace caplab::ibm

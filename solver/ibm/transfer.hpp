@@ -34,7 +34,7 @@
 //     markers are distributed (solver/bench/NOTES.md: even and odd slabs of `support` planes in
 //     two passes balanced worse). Marking
 //     the stencil nodes (mark_stencil_nodes) splits the planes the same way, so that two threads
-//     never store to one cache line of the masks. Along a periodic last axis a stencil may wrap
+//     never write one word of the union's mask. Along a periodic last axis a stencil may wrap
 //     onto the first planes, and both are serial.
 #pragma once
 
@@ -91,7 +91,7 @@ class Transfer {
     const std::ptrdiff_t m_count = static_cast<std::ptrdiff_t>(positions.size());
     x_lu_.resize(m_count);
     stencil_.resize(m_count);
-    first_plane_.resize(m_count);
+    corner_.resize(m_count);
     std::ptrdiff_t first_bad = m_count;
     int lo = grid_.n()[D - 1], hi = -1;  // the planes the stencils reach
 #pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold) \
@@ -99,9 +99,14 @@ class Transfer {
     for (std::ptrdiff_t m = 0; m < m_count; ++m) {
       x_lu_[m] = grid_.to_lattice(positions[m]);
       if (!fill_stencil(m) && m < first_bad) first_bad = m;
-      const auto& planes = stencil_[m].i[D - 1];
-      first_plane_[m] = planes[0];
-      for (int k = 0; k < support; ++k) lo = std::min(lo, planes[k]), hi = std::max(hi, planes[k]);
+      const Stencil& s = stencil_[m];
+      Corner& c = corner_[m];
+      c.cube = true;
+      for (int a = 0; a < D; ++a) {
+        c.i[a] = s.i[a][0];
+        c.cube = c.cube && s.i[a][support - 1] == s.i[a][0] + support - 1;
+      }
+      for (int k = 0; k < support; ++k) lo = std::min(lo, s.i[D - 1][k]), hi = std::max(hi, s.i[D - 1][k]);
     }
     if (first_bad < m_count)
       core::check_failed("stencil inside block", __FILE__, __LINE__,
@@ -137,22 +142,38 @@ class Transfer {
   }
 
   /// Marks every stencil node of every marker in `nodes` (in parallel over ranges of planes, as
-  /// spread(): two threads never mark one plane, so they do not write the same cache lines): a
+  /// spread(): two threads never mark one plane, so they never write one row of the mask): a
   /// row along axis 0 at once where it is `support` consecutive nodes, else node by node.
   void mark_stencil_nodes(StencilUnion& nodes) const {
     if (marker_count() == 0) return;
-    const bool rows = nodes.runs_of(support);
     for_each_marker_by_planes([&](std::size_t m, int lo, int hi) {
+      const Corner& c = corner_[m];
+      if (c.cube) {  // from the 16 bytes of its corner, not the 248 of its stencil
+        for (int plane = std::max(lo, c.i[D - 1]); plane < std::min(hi, c.i[D - 1] + support); ++plane) {
+          if constexpr (D == 2)
+            nodes.mark_run(plane, c.i[0], support);
+          else
+            for (int j = 0; j < support; ++j) nodes.mark_run(nodes.row_of(c.i[1] + j, plane), c.i[0], support);
+        }
+        return;
+      }
       const Stencil& s = stencil_[m];
-      for_each_row_in_planes(m, lo, hi, [&](std::ptrdiff_t rest, const double(&)[support]) {
-        if (rows && s.rows)
-          nodes.mark_run(s.off[0][0] + rest);
+      auto mark_row = [&](std::ptrdiff_t row) {
+        if (s.rows)
+          nodes.mark_run(row, s.i[0][0], support);
         else
-          for (int i = 0; i < support; ++i) nodes.mark_node(s.off[0][i] + rest);
-      });
+          for (int i = 0; i < support; ++i) nodes.mark_node(row, s.i[0][i]);
+      };
+      for (int k = 0; k < support; ++k) {
+        const int plane = s.i[D - 1][k];
+        if (plane < lo || plane >= hi) continue;
+        if constexpr (D == 2)
+          mark_row(plane);
+        else
+          for (int j = 0; j < support; ++j) mark_row(nodes.row_of(s.i[1][j], plane));
+      }
     });
-    const std::ptrdiff_t plane = grid_.stride(D - 1);  // the planes' linear indices: from (p + 1) * plane
-    nodes.widen((plane_lo_ + 1) * plane, (plane_hi_ + 2) * plane - 1);
+    nodes.widen(plane_lo_ * nodes.rows_per_plane(), (plane_hi_ + 1) * nodes.rows_per_plane() - 1);
   }
 
   /// out[m] = sum_x u(x) phi(x - X_m) (eq. 2.19 / 5.11), with
@@ -357,12 +378,12 @@ class Transfer {
 
   // order_ = the markers sorted stably by the plane of their first stencil node along the last
   // axis (a counting sort); plane p holds order_[plane_start_[p] .. plane_start_[p + 1]).
-  // Serial: it reads the planes from first_plane_ (4 bytes a marker) rather than the stencils
+  // Serial: it reads the planes from corner_ (16 bytes a marker) rather than the stencils
   // (a cache line and more each): the other thread waits meanwhile (solver/bench/NOTES.md).
   void sort_by_plane() {
     const int n = grid_.n()[D - 1];
     const std::size_t m_count = marker_count();
-    auto plane_of = [&](std::size_t m) { return first_plane_[m]; };
+    auto plane_of = [&](std::size_t m) { return corner_[m].i[D - 1]; };
     plane_start_.assign(n + 1, 0);
     order_.resize(m_count);
     for (std::size_t m = 0; m < m_count; ++m) ++plane_start_[plane_of(m) + 1];
@@ -419,7 +440,13 @@ class Transfer {
   std::vector<Stencil> stencil_;
   // The markers by the plane their stencil starts in, and what the threads split (sort_by_plane).
   std::vector<std::size_t> plane_start_, order_, plane_load_;
-  std::vector<int> first_plane_;  // per marker: the plane of its stencil's first node (update)
+  // Per marker: its stencil's first node, and whether the stencil is the cube of support^D
+  // nodes from it (wraps around no periodic axis). Marking the union reads these alone.
+  struct Corner {
+    int i[D];
+    bool cube;
+  };
+  std::vector<Corner> corner_;
   int plane_lo_ = 0, plane_hi_ = -1;  // the planes the stencils reach
 };
 

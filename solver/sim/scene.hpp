@@ -540,11 +540,10 @@ class Scene {
   /// between the rows of each stencil (measured: unsorted, the forced collision of a 3D
   /// capsule's ~10k stencil nodes cost five unforced updates per node).
   void collect_forced_nodes(const field::Grid<D>& grid) {
-    stencil_union_.begin(grid.size());
+    stencil_union_.begin(grid);
     for (const auto& b : bodies_)
       std::visit([&](const auto& forcing) { forcing.transfer().mark_stencil_nodes(stencil_union_); }, b.forcing);
     for (const auto& c : capsules_) c.mark_stencil_nodes(stencil_union_);
-    forced_nodes_.clear();
     stencil_union_.collect(forced_nodes_);
     collision::cover_with_spans<collision::simd_chunk<T>>(grid, forced_nodes_, forced_spans_);
   }

@@ -315,10 +315,10 @@ std::vector<std::ptrdiff_t> stencil_node_set(std::ptrdiff_t grid_size, const Tra
 }
 
 // What StencilUnion collects after the transfers mark their stencils into it.
-template <class... Transfers>
-std::vector<std::ptrdiff_t> collected_union(StencilUnion& u, std::ptrdiff_t grid_size,
+template <int D, class... Transfers>
+std::vector<std::ptrdiff_t> collected_union(StencilUnion& u, const field::Grid<D>& grid,
                                             const Transfers&... transfers) {
-  u.begin(grid_size);
+  u.begin(grid);
   (transfers.mark_stencil_nodes(u), ...);
   std::vector<std::ptrdiff_t> nodes;
   u.collect(nodes);
@@ -344,9 +344,9 @@ TEST(TransferMark, TheUnionIsExactlyTheStencilNodesInMemoryOrder) {
   const auto want = stencil_node_set(g.size(), t, r);
   StencilUnion u;
   // The second pass checks that collect() cleared the masks.
-  for (int pass = 0; pass < 2; ++pass) EXPECT_EQ(collected_union(u, g.size(), t, r), want) << "pass " << pass;
+  for (int pass = 0; pass < 2; ++pass) EXPECT_EQ(collected_union(u, g, t, r), want) << "pass " << pass;
   // Marking only the Roma3 transfer gives its stencils alone (runs of 3 this time).
-  EXPECT_EQ(collected_union(u, g.size(), r), stencil_node_set(g.size(), r));
+  EXPECT_EQ(collected_union(u, g, r), stencil_node_set(g.size(), r));
 }
 
 TEST(TransferMark, TheUnionDoesNotDependOnTheThreadCount) {
@@ -370,9 +370,31 @@ TEST(TransferMark, TheUnionDoesNotDependOnTheThreadCount) {
   const int saved = omp_get_max_threads();
   for (int threads : {1, 2, 3, 7}) {
     omp_set_num_threads(threads);
-    EXPECT_EQ(collected_union(u, g.size(), t), want) << threads << " threads";
+    EXPECT_EQ(collected_union(u, g, t), want) << threads << " threads";
   }
   omp_set_num_threads(saved);
+}
+
+TEST(TransferMark, RowsLongerThanAMaskWordIn2DAnd3D) {
+  // Rows of 130 nodes take three 64-bit words of the union's mask: stencil rows that straddle
+  // the words' boundaries (x near 64 and 128), that end on the last node, and that wrap around
+  // the periodic x are each collected once, in both dimensions, serial and in parallel.
+  std::mt19937 rng(41);
+  auto check = [&]<int D>(const field::Grid<D>& g, const auto& periodic, int count) {
+    auto x = random_positions<D>(g, count, 2.0, 7.0, rng);
+    for (auto& p : x) {  // along x: around the word boundaries and both ends
+      const double at[] = {62.5, 63.9, 64.2, 126.8, 127.5, 128.1, 129.6, 0.4, 2.0};
+      p[0] = g.origin()[0] + g.dx() * at[rng() % 9];
+    }
+    Transfer<D, Cosine4> t;
+    t.update(g, periodic, x);
+    StencilUnion u;
+    EXPECT_EQ(collected_union(u, g, t), stencil_node_set(g.size(), t)) << D << "D, " << count << " markers";
+  };
+  check(field::Grid<2>(Index<2>{130, 10}, Vec<2>(-1.0, 0.5), 0.25), std::array<bool, 2>{true, false}, 40);
+  check(field::Grid<2>(Index<2>{130, 10}, Vec<2>(-1.0, 0.5), 0.25), std::array<bool, 2>{true, false}, 600);
+  check(field::Grid<3>(Index<3>{130, 10, 11}, Vec<3>(-1.0, 0.5, 0.0), 0.25), std::array<bool, 3>{true, false, false},
+        900);
 }
 
 TEST(TransferPeriodic, AxisShorterThanTheStencilWrapsEveryNode) {
@@ -391,7 +413,7 @@ TEST(TransferPeriodic, AxisShorterThanTheStencilWrapsEveryNode) {
     EXPECT_NEAR(sum, 1.0, 1e-14);
   }
   StencilUnion u;
-  EXPECT_EQ(collected_union(u, g.size(), t), stencil_node_set(g.size(), t));
+  EXPECT_EQ(collected_union(u, g, t), stencil_node_set(g.size(), t));
 }
 
 TEST(TransferUnits, MeasureToLattice) {
