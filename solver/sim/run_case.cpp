@@ -49,7 +49,7 @@ RunResult dispatch_precision(const cases::CaseSpec& spec, const LatticeUnits& un
 /// read, the level, the overrides) and what built and ran it.
 nlohmann::json checkpoint_meta(const cases::CaseSpec& spec, int threads) {
   const auto& b = core::build_info();
-  return {{"format", 1},
+  return {{"format", checkpoint_format},
           {"source_file", spec.source_file},
           {"document", spec.document},
           {"fidelity", spec.fidelity},
@@ -106,6 +106,28 @@ RunResult drive(const cases::CaseSpec& spec, const LatticeUnits& units, int thre
 
 }  // namespace
 
+void check_checkpoint_format(const nlohmann::json& meta, const std::filesystem::path& file) {
+  const int format = meta.value("format", 1);
+  if (format == checkpoint_format) return;
+  const std::string writer = meta.value("git_sha", std::string("unknown"));
+  const std::string fix =
+      "resume it with the caplab that wrote it (git " + writer +
+      "; scripts/reproduce resumes only with the binary that started the run), or run the case afresh into a new "
+      "directory";
+  if (format > checkpoint_format)
+    throw core::InputError(fmt::format("the checkpoint '{}' has layout format {}, newer than the format {} this caplab "
+                                       "(git {}) reads: {}",
+                                       file.string(), format, checkpoint_format, core::build_info().git_sha, fix));
+  throw core::InputError(fmt::format(
+      "the checkpoint '{}' has layout format {}{} and this caplab (git {}) reads format {}: the state it stores is laid "
+      "out differently; {}",
+      file.string(), format,
+      format == 1 ? " (written before 2026-12-07, when the layout was first versioned: entries were added and resized "
+                    "under format 1)"
+                  : "",
+      core::build_info().git_sha, checkpoint_format, fix));
+}
+
 void check_series_quantities(const cases::CaseSpec& spec) {
   if (spec.physics.dimension == 2)
     check_series_quantities<2>(spec);
@@ -142,6 +164,7 @@ ResumedRun resume_case(const std::filesystem::path& run_dir, int threads, const 
   std::string meta_text;
   reader("meta", meta_text);
   const auto meta = nlohmann::json::parse(meta_text);
+  check_checkpoint_format(meta, run_dir / "checkpoint.h5");
   cases::CaseSpec spec = cases::parse_case(meta.at("document"), meta.at("source_file").get<std::string>(),
                                            meta.at("fidelity").get<std::string>(),
                                            meta.at("overrides").get<std::vector<std::string>>());

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "case/case_spec.hpp"
@@ -41,6 +42,18 @@ struct ResumedRun {
 /// a run that finished, diverged or was refused, and a directory without a checkpoint.
 ResumedRun resume_case(const std::filesystem::path& run_dir, int threads, const ProgressFn& progress,
                        const RunOptions& options = {});
+
+/// The layout of the state a checkpoint stores (Scene::checkpoint and what it calls), in the
+/// checkpoint's meta as "format". Bump it with every change of an entry's name, size or meaning:
+/// resume_case refuses another format before it reads the state.
+///   1  until 2026-12-07, unchecked: the layout changed under it ("population_stride" added,
+///      the two-level coupling history cut from 19 values to 14 channels per node)
+///   2  from 2026-12-07
+inline constexpr int checkpoint_format = 2;
+
+/// Throws core::InputError, naming `file`, the build that wrote it and the fix, when the
+/// checkpoint meta `meta` has another "format" than checkpoint_format (missing: 1).
+void check_checkpoint_format(const nlohmann::json& meta, const std::filesystem::path& file);
 
 /// Throws core::InputError when the case asks for a series quantity its dimension and bodies
 /// cannot give (scene.hpp check_series_quantities<D>); `caplab check` calls it.
