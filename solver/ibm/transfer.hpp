@@ -94,19 +94,48 @@ class Transfer {
     corner_.resize(m_count);
     std::ptrdiff_t first_bad = m_count;
     int lo = grid_.n()[D - 1], hi = -1;  // the planes the stencils reach
+    // Blocks of `lanes` markers: their nodes one by one, then their weights as vector code,
+    // a lane per marker (the cosine kernel's polynomials were most of update()'s time).
+    constexpr int lanes = 8;
+    const std::ptrdiff_t blocks = (m_count + lanes - 1) / lanes;
 #pragma omp parallel for schedule(static) if (m_count > detail::parallel_threshold) \
     reduction(min : first_bad, lo) reduction(max : hi)
-    for (std::ptrdiff_t m = 0; m < m_count; ++m) {
-      x_lu_[m] = grid_.to_lattice(positions[m]);
-      if (!fill_stencil(m) && m < first_bad) first_bad = m;
-      const Stencil& s = stencil_[m];
-      Corner& c = corner_[m];
-      c.cube = true;
-      for (int a = 0; a < D; ++a) {
-        c.i[a] = s.i[a][0];
-        c.cube = c.cube && s.i[a][support - 1] == s.i[a][0] + support - 1;
+    for (std::ptrdiff_t b = 0; b < blocks; ++b) {
+      const std::ptrdiff_t m0 = b * lanes;
+      const int count = static_cast<int>(std::min<std::ptrdiff_t>(lanes, m_count - m0));
+      // The weights' arguments; lanes past the count, and failed markers, are computed and dropped.
+      double d[D][lanes];
+      for (auto& da : d)
+        for (double& v : da) v = 1.5;
+      for (int l = 0; l < count; ++l) {
+        const std::ptrdiff_t m = m0 + l;
+        x_lu_[m] = grid_.to_lattice(positions[m]);
+        double dm[D];
+        if (place_stencil(m, dm)) {
+          for (int a = 0; a < D; ++a) d[a][l] = dm[a];
+        } else if (m < first_bad) {
+          first_bad = m;
+        }
+        const Stencil& s = stencil_[m];
+        Corner& c = corner_[m];
+        c.cube = true;
+        for (int a = 0; a < D; ++a) {
+          c.i[a] = s.i[a][0];
+          c.cube = c.cube && s.i[a][support - 1] == s.i[a][0] + support - 1;
+        }
+        for (int k = 0; k < support; ++k) lo = std::min(lo, s.i[D - 1][k]), hi = std::max(hi, s.i[D - 1][k]);
       }
-      for (int k = 0; k < support; ++k) lo = std::min(lo, s.i[D - 1][k]), hi = std::max(hi, s.i[D - 1][k]);
+      for (int a = 0; a < D; ++a) {
+        double w[support][lanes];
+#pragma omp simd
+        for (int l = 0; l < lanes; ++l) {
+          double wl[support];
+          Kernel::weights(d[a][l], wl);
+          for (int k = 0; k < support; ++k) w[k][l] = wl[k];
+        }
+        for (int l = 0; l < count; ++l)
+          for (int k = 0; k < support; ++k) stencil_[m0 + l].w[a][k] = w[k][l];
+      }
     }
     if (first_bad < m_count)
       core::check_failed("stencil inside block", __FILE__, __LINE__,
@@ -295,9 +324,10 @@ class Transfer {
   // and wrapping it into a periodic axis would lose all its digits).
   static constexpr double max_lattice_coordinate = 1 << 30;
 
-  // Fills the stencil of marker m; false if it leaves the interior along a non-periodic axis or
-  // its position has diverged.
-  bool fill_stencil(std::ptrdiff_t m) {
+  // Fills the nodes of marker m's stencil and sets d[a] to the weights' argument along each axis
+  // (the marker's distance from the stencil's first node; update() computes the weights); false
+  // if the stencil leaves the interior along a non-periodic axis or the position has diverged.
+  bool place_stencil(std::ptrdiff_t m, double (&d)[D]) {
     Stencil& st = stencil_[m];
     for (int a = 0; a < D; ++a) {
       const int n = grid_.n()[a];
@@ -307,7 +337,7 @@ class Transfer {
       const double lo = first_node(x);
       if (!periodic_[a] && (lo < 0.0 || lo + support - 1 > n - 1)) return false;
       const int i0 = static_cast<int>(lo);
-      Kernel::weights(x - i0, st.w[a]);
+      d[a] = x - i0;
       for (int s = 0; s < support; ++s) {
         const int i = i0 + s;
         // x in [0, n] gives i in [-support / 2, n + support / 2]: one wrap suffices when
