@@ -181,28 +181,35 @@ TYPED_TEST(TransferTest, SpreadDoesNotDependOnTheThreadCount) {
 TYPED_TEST(TransferTest, FieldInterpolationEqualsTheCallableForm) {
   // The capsules interpolate from a block-sized field, by rows of consecutive nodes where a
   // stencil does not wrap (periodic configurations put markers across the edges, so both
-  // paths run): the same values as the node-by-node form to round-off.
+  // paths run): the same values as the node-by-node form to round-off, below and above the
+  // parallel threshold, on any thread count.
   constexpr int D = TypeParam::D;
   std::mt19937 rng(17);
   const auto g = make_grid<D>(D == 2 ? 20 : 10);
-  const auto x = markers<TypeParam>(g, 200, rng);
-  Transfer<D, typename TypeParam::Kernel> t;
-  t.update(g, periodic_flags<TypeParam>(), x);
-  field::VectorField<D> u(g.size());
-  for (int a = 0; a < D; ++a)
-    for (auto& v : u.comp[a]) v = std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
-  std::vector<Vec<D>> by_field(x.size()), by_node(x.size());
-  t.interpolate_field(u, by_field);
-  t.interpolate(
-      [&](const Index<D>&, std::ptrdiff_t id) {
-        Vec<D> v;
-        for (int a = 0; a < D; ++a) v[a] = u.comp[a][id];
-        return v;
-      },
-      by_node);
-  const double tol = 1e-16 * Transfer<D, typename TypeParam::Kernel>::stencil_size;  // sums of that many
-  for (std::size_t m = 0; m < x.size(); ++m)
-    EXPECT_LT((by_field[m] - by_node[m]).norm(), tol) << "marker " << m;
+  const int saved = omp_get_max_threads();
+  for (int count : {200, 600})
+    for (int threads : {1, 2, 3, 7}) {
+      omp_set_num_threads(threads);
+      const auto x = markers<TypeParam>(g, count, rng);
+      Transfer<D, typename TypeParam::Kernel> t;
+      t.update(g, periodic_flags<TypeParam>(), x);
+      field::VectorField<D> u(g.size());
+      for (int a = 0; a < D; ++a)
+        for (auto& v : u.comp[a]) v = std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
+      std::vector<Vec<D>> by_field(x.size(), Vec<D>::Constant(1e300)), by_node(x.size());
+      t.interpolate_field(u, by_field);
+      t.interpolate(
+          [&](const Index<D>&, std::ptrdiff_t id) {
+            Vec<D> v;
+            for (int a = 0; a < D; ++a) v[a] = u.comp[a][id];
+            return v;
+          },
+          by_node);
+      const double tol = 1e-16 * Transfer<D, typename TypeParam::Kernel>::stencil_size;  // sums of that many
+      for (std::size_t m = 0; m < x.size(); ++m)
+        EXPECT_LT((by_field[m] - by_node[m]).norm(), tol) << count << " markers, " << threads << " threads, marker " << m;
+    }
+  omp_set_num_threads(saved);
 }
 
 TYPED_TEST(TransferTest, InterpolationExactOnUniformAndLinearFields) {
