@@ -50,7 +50,7 @@ from matplotlib import ticker  # noqa: E402
 from .convergence import observed_order  # noqa: E402
 from .figures import png_data_uri  # noqa: E402
 from .references import ReferenceLibrary  # noqa: E402
-from .runs import catalogue_cases  # noqa: E402
+from .runs import catalogue_cases, held_by_a_live_run  # noqa: E402
 
 if TYPE_CHECKING:
     from .build import Page
@@ -540,7 +540,8 @@ def read_point(family: dict, point: dict, results: Path) -> PointResult:
     elif status == "ok" and code in (0, 1, None):
         res.state = "ok"
     elif stamp and code is None:
-        res.state, res.message = "running", "started, not finished (running now, or killed)"
+        res.state, res.message = "running", ("started, not finished: running now" if held_by_a_live_run(
+            base / point["label"]) else "started, not finished: killed (rerun scripts/bench-error)")
     else:
         res.state = "failed"
         what = f"exit code {code} ({stamp.get('meaning', '?')})" if code is not None else "no stamp"

@@ -14,8 +14,10 @@ Every file is optional: a run that crashed before writing its manifest, a run st
 
 from __future__ import annotations
 
+import fcntl
 import json
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -279,6 +281,25 @@ class Run:
         return float(v) if finite(v) else None
 
 
+def held_by_a_live_run(directory: Path) -> bool:
+    """Whether a caplab process is writing ``directory`` now: a live run holds an exclusive
+    ``flock`` on the directory (solver/io/run_directory.cpp), so a shared one is refused here; a
+    killed run's lock went with its process."""
+    try:
+        fd = os.open(directory, os.O_RDONLY | os.O_DIRECTORY)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return True
+    except OSError:
+        return False
+    finally:
+        os.close(fd)  # also releases the shared lock taken here
+    return False
+
+
 def load_run(directory: Path | None, case_id: str, fidelity: str, side: Path | None = None,
              log: Path | None = None) -> Run:
     run = Run(case_id=case_id, fidelity=fidelity, directory=directory)
@@ -309,7 +330,9 @@ def load_run(directory: Path | None, case_id: str, fidelity: str, side: Path | N
         stopped = run.manifest.get("interrupted") if status == "failed" else None
         run.status = "incomplete" if status in (None, "running") or stopped else str(status)
         if status == "running":
-            run.problems.append("manifest.json still says \"running\": the process was killed or is still going")
+            run.problems.append("manifest.json still says \"running\": " + (
+                "a caplab process is writing it now (it holds the directory's lock)" if held_by_a_live_run(directory)
+                else "its process was killed (nobody holds the directory's lock); a checkpoint, if any, resumes it"))
         if isinstance(stopped, dict):
             run.problems.append(f"stopped by {stopped.get('signal')} after step {stopped.get('step')}, checkpoint "
                                 "kept: `caplab run --resume` (or the next reproduce) continues it")

@@ -413,3 +413,27 @@ def test_runner_bad_series_and_family(runner, tmp_path):
     proc = runner["run"]("--only", "nope")
     assert proc.returncode != 0 and "--only nope: no such family; the series has cyl, other" in proc.stderr
     assert runner["count"]() == 0
+
+
+def test_point_started_and_not_finished_says_whether_it_is_running(tmp_path):
+    """A point whose stamp has no exit code and whose manifest says "running": running now while a
+    caplab holds its directory's lock, killed once nobody does."""
+    import fcntl
+    import os
+    series = bench.load_series(SERIES, REPO)
+    fam = series["families"][0]
+    point = next(p for p in fam["points"] if not p.get("quick"))
+    base = tmp_path / fam["id"]
+    run = fakes.make_run_dir(base / point["label"], fakes.cylinder_case(), point["fidelity"], "running")
+    fakes.write_json(base / f"{point['label']}.reproduce.json",
+                     {"case_id": "ch2/cylinder_re100", "case_file": str(REPO / fam["case"]),
+                      "fidelity": point["fidelity"], "overrides": bench.point_overrides(point), "threads": 1})
+    fd = os.open(run, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        live = bench.read_point(fam, point, tmp_path)
+    finally:
+        os.close(fd)
+    killed = bench.read_point(fam, point, tmp_path)
+    assert live.state == killed.state == "running"
+    assert "running now" in live.message and "killed" in killed.message, (live.message, killed.message)

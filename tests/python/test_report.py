@@ -165,6 +165,26 @@ def test_killed_run_is_incomplete(tmp_path):
     assert run.status == "incomplete" and run.verdict == "fail" and run.sanity == "fail"
 
 
+def test_killed_run_is_told_from_a_live_one_by_the_directory_lock(tmp_path):
+    """A live caplab holds an exclusive flock on its run directory (solver/io/run_directory.cpp):
+    the report says "writing it now" while one is held and "killed" once it is gone."""
+    import fcntl
+    import os
+    case = fakes.cylinder_case()
+    run_dir = fakes.make_run_dir(tmp_path / "quick" / "ch2__cylinder_re100", case, "quick", "running")
+    fd = os.open(run_dir, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # as the running caplab does
+        live = load_run(run_dir, case["id"], "quick")
+    finally:
+        os.close(fd)
+    killed = load_run(run_dir, case["id"], "quick")
+    assert live.status == killed.status == "incomplete"
+    assert any("writing it now" in p for p in live.problems), live.problems
+    assert any("was killed" in p for p in killed.problems), killed.problems
+    assert not any("writing it now" in p for p in killed.problems)
+
+
 def test_stopped_run_is_incomplete(tmp_path):
     """Ctrl-C or SIGTERM: caplab finished the manifest "failed" with an "interrupted" entry."""
     case = fakes.cylinder_case()
