@@ -117,12 +117,6 @@ class Transfer {
           first_bad = m;
         }
         const Stencil& s = stencil_[m];
-        Corner& c = corner_[m];
-        c.cube = true;
-        for (int a = 0; a < D; ++a) {
-          c.i[a] = s.i[a][0];
-          c.cube = c.cube && s.i[a][support - 1] == s.i[a][0] + support - 1;
-        }
         for (int k = 0; k < support; ++k) lo = std::min(lo, s.i[D - 1][k]), hi = std::max(hi, s.i[D - 1][k]);
       }
       for (int a = 0; a < D; ++a) {
@@ -175,15 +169,21 @@ class Transfer {
   /// row along axis 0 at once where it is `support` consecutive nodes, else node by node.
   void mark_stencil_nodes(StencilUnion& nodes) const {
     if (marker_count() == 0) return;
+    // mark_row(row) for the mask rows of a stencil in `plane`: the plane itself in 2D, its
+    // support rows i1(0) ... i1(support - 1) in 3D.
+    auto rows_in_plane = [&](int plane, const auto& i1, const auto& mark_row) {
+      if constexpr (D == 2)
+        mark_row(plane);
+      else
+        for (int j = 0; j < support; ++j) mark_row(nodes.row_of(i1(j), plane));
+    };
     for_each_marker_by_planes([&](std::size_t m, int lo, int hi) {
       const Corner& c = corner_[m];
       if (c.cube) {  // from the 16 bytes of its corner, not the 248 of its stencil
-        for (int plane = std::max(lo, c.i[D - 1]); plane < std::min(hi, c.i[D - 1] + support); ++plane) {
-          if constexpr (D == 2)
-            nodes.mark_run(plane, c.i[0], support);
-          else
-            for (int j = 0; j < support; ++j) nodes.mark_run(nodes.row_of(c.i[1] + j, plane), c.i[0], support);
-        }
+        for (int plane = std::max(lo, c.i[D - 1]); plane < std::min(hi, c.i[D - 1] + support); ++plane)
+          rows_in_plane(
+              plane, [&](int j) { return c.i[1] + j; },
+              [&](std::ptrdiff_t row) { nodes.mark_run(row, c.i[0], support); });
         return;
       }
       const Stencil& s = stencil_[m];
@@ -195,11 +195,7 @@ class Transfer {
       };
       for (int k = 0; k < support; ++k) {
         const int plane = s.i[D - 1][k];
-        if (plane < lo || plane >= hi) continue;
-        if constexpr (D == 2)
-          mark_row(plane);
-        else
-          for (int j = 0; j < support; ++j) mark_row(nodes.row_of(s.i[1][j], plane));
+        if (plane >= lo && plane < hi) rows_in_plane(plane, [&](int j) { return s.i[1][j]; }, mark_row);
       }
     });
     nodes.widen(plane_lo_ * nodes.rows_per_plane(), (plane_hi_ + 1) * nodes.rows_per_plane() - 1);
@@ -324,9 +320,10 @@ class Transfer {
   // and wrapping it into a periodic axis would lose all its digits).
   static constexpr double max_lattice_coordinate = 1 << 30;
 
-  // Fills the nodes of marker m's stencil and sets d[a] to the weights' argument along each axis
-  // (the marker's distance from the stencil's first node; update() computes the weights); false
-  // if the stencil leaves the interior along a non-periodic axis or the position has diverged.
+  // Fills the nodes of marker m's stencil and its corner, and sets d[a] to the weights' argument
+  // along each axis (the marker's distance from the stencil's first node; update() computes the
+  // weights); false if the stencil leaves the interior along a non-periodic axis or the position
+  // has diverged.
   bool place_stencil(std::ptrdiff_t m, double (&d)[D]) {
     Stencil& st = stencil_[m];
     for (int a = 0; a < D; ++a) {
@@ -351,7 +348,14 @@ class Transfer {
         st.off[a][s] = (st.i[a][s] + 1) * grid_.stride(a);
       }
     }
-    st.rows = st.i[0][support - 1] == st.i[0][0] + support - 1;
+    auto unwrapped = [&](int a) { return st.i[a][support - 1] == st.i[a][0] + support - 1; };
+    st.rows = unwrapped(0);
+    Corner& c = corner_[m];
+    c.cube = true;
+    for (int a = 0; a < D; ++a) {
+      c.i[a] = st.i[a][0];
+      c.cube = c.cube && unwrapped(a);
+    }
     return true;
   }
 

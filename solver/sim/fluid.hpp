@@ -41,7 +41,7 @@ class Fluid {
     Force force;          // allocated when the block is ever forced
     bool has_body_force = false;
     field::Box<D> skip;  // nodes its sweep leaves alone: the covered nodes of a coarse block
-    int row_start = 0;   // the sweep's x0: −1 on a fine block (collision::ghost_row_start)
+    int row_start = 0;   // the sweep's x0: on a fine block collision::ghost_row_start (−1 or 0)
   };
 
   struct Setup {
