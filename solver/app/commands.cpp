@@ -36,10 +36,15 @@ void print_units(const cases::CaseSpec& spec, const sim::LatticeUnits& u) {
     std::string nodes;
     for (std::size_t a = 0; a < b.nodes.size(); ++a) nodes += (a ? " x " : "") + std::to_string(b.nodes[a]);
     // TRT: the odd moments' relaxation time too; far above 1 it lets interface and IB errors persist.
+    // A bulk viscosity of its own: the bulk mode's.
     const auto& col = spec.numerics.collision;
-    const std::string tau_minus = col.op == cases::CollisionSpec::Operator::trt
-                                      ? fmt::format(" (tau- = {:.3g})", collision::Trt{b.tau, col.magic}.tau_minus())
-                                      : std::string();
+    const bool trt = col.op == cases::CollisionSpec::Operator::trt;
+    std::string tau_minus = trt ? fmt::format("tau- = {:.3g}", collision::Trt{b.tau, col.magic}.tau_minus()) : "";
+    if (col.bulk_viscosity_ratio)
+      tau_minus += fmt::format("{}tau_bulk = {:.4g}", trt ? ", " : "",
+                               collision::TrtBulk{b.tau, col.magic, *col.bulk_viscosity_ratio, !trt}.tau_bulk(
+                                   spec.physics.dimension));
+    if (!tau_minus.empty()) tau_minus = " (" + tau_minus + ")";
     fmt::print("  block {:8s} dx = {:.5g} L, dt = {:.5g} L/U, tau = {:.5f}{}, nu_lu = {:.5g}, nodes {}\n", b.name, b.dx,
                b.dt, b.tau, tau_minus, b.nu_lu, nodes);
   }

@@ -135,7 +135,8 @@ SchemaNode build_case_schema() {
                           opt("fine_region",  // two_level only (required there)
                               object({req("min", per_axis(number())), req("max", per_axis(number()))}))})),
       req("collision", object({req("operator", choice(enum_names(collision_names))),
-                               opt("magic", number(positive))})),  // trt only
+                               opt("magic", number(positive)),  // trt only
+                               opt("bulk_viscosity_ratio", number(Range{0, 1e4, true, false}))})),
       req("precision", choice(enum_names(precision_names))),
       opt("ib",
           object({opt("kernel", choice(enum_names(kernel_names))), opt("marker_spacing", number(closed(0.05, 2))),

@@ -122,6 +122,9 @@ struct CollisionSpec {
   enum class Operator { bgk, trt };
   Operator op = Operator::bgk;
   double magic = 0.25;  ///< TRT magic parameter Λ = (τ+ − ½)(τ− − ½)
+  /// ζ/μ, the bulk to the shear viscosity, when the bulk mode relaxes with its own time
+  /// (collision::TrtBulk); absent: the operator's own 2/D.
+  std::optional<double> bulk_viscosity_ratio;
 };
 
 struct IbSpec {

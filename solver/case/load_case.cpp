@@ -276,6 +276,8 @@ CaseSpec to_spec(const json& doc, const CaseDiagnostics& diag) {
   const json& collision = n.at("collision");
   numerics.collision.op = enum_value(collision_names, collision.at("operator").get<std::string>());
   numerics.collision.magic = collision.value("magic", numerics.collision.magic);
+  if (collision.contains("bulk_viscosity_ratio"))
+    numerics.collision.bulk_viscosity_ratio = collision.at("bulk_viscosity_ratio").get<double>();
   numerics.precision = enum_value(precision_names, n.at("precision").get<std::string>());
   const json ib = n.value("ib", json::object());
   if (ib.contains("kernel"))

@@ -135,8 +135,9 @@ template <int w, bool Forced, class L, class T, bool Velocity = false, class Op>
                                                  std::ptrdiff_t at, int rem, double* const* up = nullptr) {
   if constexpr (w >= 1) {
     if (rem & w) {
+      const Op op_l = op;  // as in update_run
 #pragma omp simd
-      for (int x = 0; x < w; ++x) update_node<Forced, L, T, Velocity>(P, op, fp, at + x, up);
+      for (int x = 0; x < w; ++x) update_node<Forced, L, T, Velocity>(P, op_l, fp, at + x, up);
       at += w;
     }
     update_pieces<w / 2, Forced, L, T, Velocity>(P, op, fp, at, rem, up);
@@ -151,8 +152,9 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
 [[gnu::noinline, gnu::flatten]] void update_tail(T* const (&P)[L::q], const Op& op, const double* const (&fp)[L::d],
                                                std::ptrdiff_t at, int rem, double* const* up = nullptr) {
   constexpr int W = simd_chunk<T>;
+  const Op op_l = op;  // as in update_run
 #pragma omp simd
-  for (int x = 0; x < W; ++x) update_node<Forced, L, T, Velocity>(P, op, fp, at + x, up, x < rem);
+  for (int x = 0; x < W; ++x) update_node<Forced, L, T, Velocity>(P, op_l, fp, at + x, up, x < rem);
 }
 
 /// The first x of the fused kernel's row runs (the x0 of sweep) on a block of nx nodes per row
@@ -180,13 +182,16 @@ template <bool Forced, class L, class T, bool Velocity = false, class Op>
                                               std::ptrdiff_t at, int n, double* const* up = nullptr) {
   constexpr int W = simd_chunk<T>;
   const int whole = n - n % W;
+  // A copy in registers: through the reference, the stores through P might alias op's members,
+  // and with more than a few of them (TrtBulk) GCC 12 gave up vectorizing the loop.
+  const Op op_l = op;
   for (int x0 = 0; x0 < whole; x0 += W) {
     const std::ptrdiff_t chunk = at + x0;
     // Past the run's end this reaches the next rows, contiguous in memory (x fastest), which
     // this thread takes next under the static schedule; past the array's end it is harmless.
     prefetch_node<L::q>(P, chunk + prefetch_lines * W);
 #pragma omp simd
-    for (int x = 0; x < W; ++x) update_node<Forced, L, T, Velocity>(P, op, fp, chunk + x, up);
+    for (int x = 0; x < W; ++x) update_node<Forced, L, T, Velocity>(P, op_l, fp, chunk + x, up);
   }
   if constexpr (W >= 16) {
     if (whole < n) update_tail<Forced, L, T, Velocity>(P, op, fp, at + whole, n - whole, up);

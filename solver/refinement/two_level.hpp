@@ -17,7 +17,9 @@
 // which keep ρ, u and the viscous stress continuous (f_neq ∝ τ Δt ∇u, τ_f = ½ + m(τ_c − ½)).
 // The even and odd parts of f_neq are rescaled with their own relaxation times (τ+ and τ−
 // of TRT; equal for BGK): the odd part ∝ τ− Δt, and rescaling it with τ+ breaks the
-// exactness of linear shear across the interface (measured 1e-4 instead of 1e-7).
+// exactness of linear shear across the interface (measured 1e-4 instead of 1e-7). With an
+// operator whose bulk mode relaxes on its own (collision::TrtBulk) the bulk part of the even
+// part, β_i Π (collision::bulk_shape), is rescaled with τ_b: f_neq's trace Π ∝ τ_b Δt ∇·u.
 // Fine ghost values off coarse nodes use the symmetric 4-point (cubic) midpoint stencil
 // (−1, 9, 9, −1)/16 along each axis where the node lies half way, in time the 3-point
 // Lagrange formula (eq. 2.14) through t_{n−1}, t_n, t_{n+1}. The ghost node is then collided
@@ -33,7 +35,8 @@
 // and of each plane node only what its face's ghosts use (channels): the density and momentum
 // (D + 1 values) and the populations that enter through the face and their opposites (2E);
 // 14 of 19 values in D3Q19 (9 of 9 in D2Q9), 4 + 5 of them with BGK, whose rescaling and
-// collision need no opposite. The moments and the interpolation are linear, so interpolated
+// collision need no opposite; with a bulk mode of its own also the trace of the second moment
+// (the ghost's Π, which the kept populations alone do not give). The moments and the interpolation are linear, so interpolated
 // moments are the moments of the interpolated populations (to round-off): the ghosts' ρ and u
 // come from them.
 //
@@ -76,28 +79,37 @@ class TwoLevel {
     for (int i = 0; i < Q; ++i) n += lattice::enters_through_face<L>(0, i) ? 1 : 0;
     return n;
   }();
-  static constexpr int C = D + 1 + 2 * E;
+  /// Channels: δρ, j, the E entering populations, their opposites, the trace of the second
+  /// moment (the last, kept only with a bulk mode of its own).
+  static constexpr int C = D + 2 + 2 * E;
+  static constexpr int trace_channel = C - 1;
   /// The channels the fill of operator Op reads (captured and interpolated): BGK rescales and
-  /// collides each population alone, so not the opposites.
+  /// collides each population alone, so not the opposites; only an operator with a bulk mode
+  /// of its own reads the trace.
   template <class Op>
-  static constexpr int kept_channels = std::is_same_v<Op, collision::Bgk> ? D + 1 + E : C;
+  static constexpr int kept_channels = std::is_same_v<Op, collision::Bgk> ? D + 1 + E
+                                       : collision::has_bulk_mode<Op>     ? C
+                                                                          : C - 1;
 
   TwoLevel() = default;
-  /// Relaxation times of the even (τ+) and odd (τ−) non-equilibrium parts of one block.
+  /// Relaxation times of the even (τ+), odd (τ−) and bulk (τ_b) non-equilibrium parts of one
+  /// block.
   struct Taus {
-    double plus, minus;
+    double plus, minus, bulk;
   };
-  /// `tau_c`, `tau_f`: relaxation times of the two blocks (τ_f+ = ½ + m(τ_c+ − ½)).
-  TwoLevel(const field::Grid<D>& coarse, const field::Grid<D>& fine, Taus tau_c, Taus tau_f)
+  /// `tau_c`, `tau_f`: relaxation times of the two blocks (τ_f+ = ½ + m(τ_c+ − ½)); `trace`:
+  /// whether the operator relaxes its bulk mode on its own (the history then keeps the trace).
+  TwoLevel(const field::Grid<D>& coarse, const field::Grid<D>& fine, Taus tau_c, Taus tau_f, bool trace)
       : coarse_(coarse),
         fine_(fine),
-        c_from_f_{m * tau_c.plus / tau_f.plus, m * tau_c.minus / tau_f.minus},
-        f_from_c_{tau_f.plus / (m * tau_c.plus), tau_f.minus / (m * tau_c.minus)} {
+        c_from_f_{m * tau_c.plus / tau_f.plus, m * tau_c.minus / tau_f.minus, m * tau_c.bulk / tau_f.bulk},
+        f_from_c_{tau_f.plus / (m * tau_c.plus), tau_f.minus / (m * tau_c.minus), tau_f.bulk / (m * tau_c.bulk)},
+        trace_(trace) {
     CAPLAB_CHECK(std::abs(coarse.dx() - m * fine.dx()) < 1e-12 * coarse.dx(),
                  "two-level coupling needs coarse spacing = 2 × fine spacing");
     build_restriction();
     build_faces();
-    history_.assign(3 * C * sources_.size(), T(0));
+    history_.assign(3 * stored_channels() * sources_.size(), T(0));
   }
 
   /// Records what the fine ghosts of the fill with operator Op need of the coarse block at the
@@ -122,8 +134,9 @@ class TwoLevel {
     // 3-point Lagrange through t_{n-1} = −1, t_n = 0, t_{n+1} = 1 (eq. 2.14).
     const T lag[3] = {T(0.5 * s * (s - 1.0)), T((1.0 - s) * (1.0 + s)), T(0.5 * s * (s + 1.0))};
     const std::size_t S = sources_.size();
-    const T* h[3] = {&history_[(newest_ + 1) % 3 * C * S], &history_[(newest_ + 2) % 3 * C * S],
-                     &history_[newest_ * C * S]};  // t_{n-1}, t_n, t_{n+1}
+    const std::size_t level = stored_channels() * S;
+    const T* h[3] = {&history_[(newest_ + 1) % 3 * level], &history_[(newest_ + 2) % 3 * level],
+                     &history_[newest_ * level]};  // t_{n-1}, t_n, t_{n+1}
     constexpr int channels = kept_channels<Op>;
     const std::array<T*, Q> P = fine.bases();
     // Scratch per thread, sized once (and again only if more threads run than before).
@@ -196,7 +209,7 @@ class TwoLevel {
           if (leaving >> i & 1U) dst[L::opposite[i]][n] = post[i][b];
       }
     };
-    for_each_restricted_batch(fine, band_, collide, store);
+    for_each_restricted_batch<collision::has_bulk_mode<Op>>(fine, band_, collide, store);
   }
 
   /// Sets every covered coarse node from the fine block. Nothing needs it (the coarse sweep
@@ -265,8 +278,10 @@ class TwoLevel {
   void collide_ghosts(const T (&coarse_c)[C][batch], const std::array<T*, Q>& P, const Op& op,
                       std::ptrdiff_t k0) const {
     constexpr std::array<int, 2 * E> pops = channel_populations(Face);
-    constexpr int kept = kept_channels<Op> - (D + 1);  // 2E, or E without the opposites (BGK)
+    constexpr bool bulk = collision::has_bulk_mode<Op>;
+    constexpr int kept = std::min(kept_channels<Op>, C - 1) - (D + 1);  // 2E, or E without the opposites (BGK)
     const T half_plus = T(0.5 * f_from_c_.plus), half_minus = T(0.5 * f_from_c_.minus);
+    const T bulk_minus_plus = T(f_from_c_.bulk - f_from_c_.plus), s_bulk = T(f_from_c_.bulk);
     T post[Q][batch];
 #pragma omp simd
     for (int b = 0; b < batch; ++b) {
@@ -283,7 +298,15 @@ class TwoLevel {
 #pragma GCC unroll 10
       for (int e = 0; e < kept; ++e)
         f[pops[e]] = rescaled(feq[pops[e]], neq[e], neq[e < E ? e + E : e - E], half_plus, half_minus);
-      op.template collide<L, T>(f, feq, out);
+      if constexpr (bulk) {
+        // The bulk part β_i Π of the even part rescaled with s_b, and the fine Π = s_b Π_c.
+        const T trace = coarse_c[trace_channel][b] - collision::second_moment_trace<L, T>(feq);
+#pragma GCC unroll 10
+        for (int e = 0; e < kept; ++e) f[pops[e]] += bulk_minus_plus * T(collision::bulk_shape<L>(pops[e])) * trace;
+        op.template collide_with_trace<L, T>(f, feq, s_bulk * trace, out);
+      } else {
+        op.template collide<L, T>(f, feq, out);
+      }
 #pragma GCC unroll 19
       for (int i = 0; i < Q; ++i)
         if (lattice::enters_through_face<L>(Face, i)) post[i][b] = out[i];
@@ -365,7 +388,9 @@ class TwoLevel {
   }
 
   /// f ← f_eq + s+ · (even part of f_neq) + s− · (odd part of f_neq), with feq the equilibrium
-  /// of f's moments (which the rescaling keeps).
+  /// of f's moments (which the rescaling keeps); with Bulk the even part's bulk part β_i Π
+  /// with s_b.
+  template <bool Bulk>
   static void rescale_non_equilibrium(T (&f)[Q], T (&feq)[Q], const Taus& s) {
     T rho, u[D];
     collision::moments<L, T>(f, rho, u);
@@ -378,6 +403,11 @@ class TwoLevel {
     const T half_plus = T(0.5 * s.plus), half_minus = T(0.5 * s.minus);
 #pragma GCC unroll 19
     for (int i = 0; i < Q; ++i) f[i] = rescaled(feq[i], neq[i], neq[L::opposite[i]], half_plus, half_minus);
+    if constexpr (Bulk) {
+      const T bulk = T(s.bulk - s.plus) * collision::second_moment_trace<L, T>(neq);
+#pragma GCC unroll 19
+      for (int i = 0; i < Q; ++i) f[i] += T(collision::bulk_shape<L>(i)) * bulk;
+    }
   }
 
   /// Coarse index of a fine position, as twice the coordinate (odd = half way between nodes).
@@ -530,15 +560,18 @@ class TwoLevel {
       for (int b = 0; b < batch; ++b)
         for (int i = 0; i < Q; ++i) dst[i][nodes.coarse[k0 + b]] = out[i][b];
     };
-    for_each_restricted_batch(fine, nodes, keep, store);
+    if (trace_)
+      for_each_restricted_batch<true>(fine, nodes, keep, store);
+    else
+      for_each_restricted_batch<false>(fine, nodes, keep, store);
   }
 
   /// For each batch of `nodes`, in parallel: the fine populations of its fine nodes rescaled to
   /// the coarse block (the restriction), through node(f, out) per node in one vector loop
   /// (`node` marked always_inline and its loops unrolled, or GCC 12 leaves the loop scalar), then
   /// store(k0, out) with out[i][b] for the batch's coarse nodes k0 + b (scattered stores,
-  /// outside the vector loop).
-  template <class Node, class Store>
+  /// outside the vector loop). Bulk: the operator relaxes its bulk mode on its own.
+  template <bool Bulk, class Node, class Store>
   void for_each_restricted_batch(const field::Populations<L, T>& fine, const NodePairs& nodes, const Node& node,
                                  const Store& store) const {
     const std::array<const T*, Q> bases = fine.bases();
@@ -557,7 +590,7 @@ class TwoLevel {
         // 32-bit node indices into each population's array: a vector gather (as the far field).
 #pragma GCC unroll 19
         for (int i = 0; i < Q; ++i) f[i] = src[i][fine_node[k0 + b]];
-        rescale_non_equilibrium(f, feq, c_from_f_);
+        rescale_non_equilibrium<Bulk>(f, feq, c_from_f_);
         node_l(f, post);
 #pragma GCC unroll 19
         for (int i = 0; i < Q; ++i) out[i][b] = post[i];
@@ -576,7 +609,7 @@ class TwoLevel {
   void store_level(const field::Populations<L, T>& coarse, int level) {
     const std::size_t S = sources_.size();
     const std::array<const T*, Q> P = coarse.bases();
-    T* out = &history_[level * C * S];
+    T* out = &history_[level * stored_channels() * S];
 #pragma omp parallel
     for (int face = 0; face < 2 * D; ++face) {
       const auto pops = channel_populations(face);
@@ -591,13 +624,18 @@ class TwoLevel {
         collision::shifted_density_momentum<L, T>(f, drho, j);
         out[k] = drho;
         for (int a = 0; a < D; ++a) out[(1 + a) * S + k] = j[a];
-        for (int e = 0; e < Channels - (D + 1); ++e) out[(D + 1 + e) * S + k] = f[pops[e]];
+        for (int e = 0; e < std::min(Channels, C - 1) - (D + 1); ++e) out[(D + 1 + e) * S + k] = f[pops[e]];
+        if constexpr (Channels == C) out[trace_channel * S + k] = collision::second_moment_trace<L, T>(f);
       }
     }
   }
 
+  /// Channels per level in the history: the trace only when the operator reads it.
+  std::size_t stored_channels() const { return trace_ ? C : C - 1; }
+
   field::Grid<D> coarse_, fine_;
-  Taus c_from_f_{1.0, 1.0}, f_from_c_{1.0, 1.0};  // rescaling factors of the even and odd parts
+  Taus c_from_f_{1.0, 1.0, 1.0}, f_from_c_{1.0, 1.0, 1.0};  // rescaling factors of the even, odd, bulk parts
+  bool trace_ = false;  // the history keeps the trace channel
   std::vector<Face> faces_;
   std::vector<Chunk> chunks_;               // the tasks of fill_fine_ghosts
   std::vector<std::ptrdiff_t> sources_;     // coarse nodes of the face planes, face after face

@@ -61,8 +61,9 @@ class Fluid {
       Op fine_op = s.coarse_op;
       fine_op.tau = 0.5 + 2.0 * (s.coarse_op.tau - 0.5);  // thesis eq. 2.10, m = 2
       blocks_.push_back(make_block(*s.fine, fine_op));
-      coupling_ = refinement::TwoLevel<L, T>(s.coarse, *s.fine, {s.coarse_op.tau, s.coarse_op.tau_minus()},
-                                             {fine_op.tau, fine_op.tau_minus()});
+      coupling_ = refinement::TwoLevel<L, T>(
+          s.coarse, *s.fine, {s.coarse_op.tau, s.coarse_op.tau_minus(), s.coarse_op.tau_bulk(D)},
+          {fine_op.tau, fine_op.tau_minus(), fine_op.tau_bulk(D)}, collision::has_bulk_mode<Op>);
       blocks_[0].skip = coupling_.idle_coarse();
       // Nothing reads the fine block's ghost layer: the fill overwrites what its ghosts push in.
       blocks_[1].row_start = collision::ghost_row_start<T>(s.fine->n()[0]);

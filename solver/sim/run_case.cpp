@@ -34,8 +34,11 @@ RunResult run_scene(const cases::CaseSpec& spec, const LatticeUnits& units, cons
 template <class L, class T>
 RunResult dispatch_operator(const cases::CaseSpec& spec, const LatticeUnits& units, const Drive& d) {
   const double tau = units.blocks[0].tau;
-  if (spec.numerics.collision.op == cases::CollisionSpec::Operator::trt)
-    return run_scene<L, T>(spec, units, collision::Trt{tau, spec.numerics.collision.magic}, d);
+  const auto& col = spec.numerics.collision;
+  const bool trt = col.op == cases::CollisionSpec::Operator::trt;
+  if (col.bulk_viscosity_ratio)
+    return run_scene<L, T>(spec, units, collision::TrtBulk{tau, col.magic, *col.bulk_viscosity_ratio, !trt}, d);
+  if (trt) return run_scene<L, T>(spec, units, collision::Trt{tau, col.magic}, d);
   return run_scene<L, T>(spec, units, collision::Bgk{tau}, d);
 }
 

@@ -6,6 +6,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -71,6 +72,12 @@ void uniform_flow_stays_uniform(Op op) {
 
 TEST(TwoLevel, UniformFlowUnchanged2D) { uniform_flow_stays_uniform<lattice::D2Q9>(collision::Bgk{0.7}); }
 TEST(TwoLevel, UniformFlowUnchanged3D) { uniform_flow_stays_uniform<lattice::D3Q19>(collision::Trt{0.7, 0.25}); }
+TEST(TwoLevel, UniformFlowUnchangedTrtBulk2D) {
+  uniform_flow_stays_uniform<lattice::D2Q9>(collision::TrtBulk{0.7, 0.25, 30.0});
+}
+TEST(TwoLevel, UniformFlowUnchangedTrtBulk3D) {
+  uniform_flow_stays_uniform<lattice::D3Q19>(collision::TrtBulk{0.7, 0.25, 30.0});
+}
 TEST(TwoLevel, UniformFlowUnchangedAtTauOne) {
   // τ_c = 1 is where eq. 2.11/2.12 are singular; the pre-collision transfer is not.
   uniform_flow_stays_uniform<lattice::D2Q9>(collision::Bgk{1.0});
@@ -127,6 +134,77 @@ TEST(TwoLevel, LinearShearTrtNonlinearResidualOnly) {
   const double e2 = couette_error<lattice::D2Q9>(collision::Trt{0.8, 0.25}, 8000, 0.002);
   EXPECT_LT(e1, 1e-4);
   EXPECT_GT(e1 / e2, 8.0);
+}
+
+// With a bulk mode of its own the nonlinear residual grows with τ_b (measured at u_w = 0.02:
+// ratio ζ/μ = 1, which is TRT, 6.0e-5; 3: 8.3e-5; 10: 1.5e-4; 30: 2.6e-4, and 5.5e-6 at
+// u_w = 0.002), still vanishing in the Stokes limit. Rescaling the ghosts' bulk part with the
+// shear's factor instead of its own doubles it (5.6e-4 at ratio 30), which the bound catches.
+TEST(TwoLevel, LinearShearTrtBulkNonlinearResidualOnly) {
+  const double e1 = couette_error<lattice::D2Q9>(collision::TrtBulk{0.8, 0.25, 30.0}, 8000, 0.02);
+  const double e2 = couette_error<lattice::D2Q9>(collision::TrtBulk{0.8, 0.25, 30.0}, 8000, 0.002);
+  EXPECT_LT(e1, 3e-4);
+  EXPECT_GT(e1 / e2, 8.0);
+}
+
+/// A plane standing sound wave ρ' ∝ cos(k x) on a periodic 64² coarse box whose middle
+/// [20, 44]² is a fine block: its decay rate, measured on the coarse rows beside the block,
+/// against Γ = k²/2 [(2 − 2/D) ν + ζ/ρ] (test_channel_flows: SoundAttenuation). The wave
+/// crosses the interface twice per period.
+template <class Op>
+double sound_rate_through_interface(Op op, double bulk_ratio) {
+  const int n = 64;
+  auto [c, f] = two_blocks<2>({n, n}, Vec<2>::Zero(), 20, 44);
+  typename sim::Fluid<lattice::D2Q9, double, Op>::Setup s;
+  s.coarse = c;
+  s.fine = f;
+  s.boundaries = {Kind::periodic, Kind::periodic};
+  s.imposed_velocity_lu = [](const Vec<2>&) { return Vec<2>::Zero(); };
+  s.coarse_op = op;
+  sim::Fluid<lattice::D2Q9, double, Op> fluid(s);
+  const double kw = 2 * std::numbers::pi / n, eps = 1e-4;
+  fluid.initialise([&](const Vec<2>& x) { return std::pair{1.0 + eps * std::cos(kw * x[0]), Vec<2>::Zero().eval()}; });
+  auto amplitude = [&] {
+    const auto& blk = fluid.block(0);
+    double a = 0;
+    for (int j = 0; j < n; ++j) {
+      if (j >= 18 && j <= 46) continue;  // rows beside the block only
+      for (int i = 0; i < n; ++i) {
+        const auto node = blk.pop.grid().index({i, j});
+        double rho = 0;
+        for (int q = 0; q < 9; ++q) rho += blk.pop(q, node);
+        a += rho * std::cos(kw * i);
+      }
+    }
+    return a;
+  };
+  const double nu = (op.tau - 0.5) / 3.0;
+  const double rate = 0.5 * kw * kw * (nu + bulk_ratio * nu);
+  const int steps = static_cast<int>(std::min(4.0 / rate, 2000.0));
+  std::vector<double> A;
+  for (int t = 0; t < steps; ++t) {
+    fluid.step();
+    A.push_back(amplitude());
+  }
+  double st = 0, sl = 0, stt = 0, stl = 0;
+  int m = 0;
+  for (int t = 50; t + 1 < steps; ++t) {  // extrema of |A|, parabola through three steps
+    const double a = std::abs(A[t - 1]), b = std::abs(A[t]), cc = std::abs(A[t + 1]);
+    if (!(b > a && b >= cc)) continue;
+    const double dt = 0.5 * (a - cc) / (a - 2 * b + cc);
+    const double tp = t + dt, lp = std::log(b - 0.25 * (a - cc) * dt);
+    st += tp, sl += lp, stt += tp * tp, stl += tp * lp, ++m;
+  }
+  EXPECT_GE(m, 6);
+  const double measured = -(m * stl - st * sl) / (m * stt - st * st);
+  return measured / rate;
+}
+
+// Measured 1.000 (TRT) and 0.995 (ratio 20); a fine block with the coarse τ_b (one ζ/ρ in
+// lattice units instead of one physical ζ) would slow the decay by about a sixth.
+TEST(TwoLevel, SoundCrossesTheInterfaceAtItsBulkViscosity) {
+  EXPECT_NEAR(sound_rate_through_interface(collision::Trt{0.6, 0.25}, 1.0), 1.0, 0.02);
+  EXPECT_NEAR(sound_rate_through_interface(collision::TrtBulk{0.6, 0.25, 20.0}, 20.0), 1.0, 0.02);
 }
 
 using VortexFluid = sim::Fluid<lattice::D2Q9, double, collision::Bgk>;
@@ -302,7 +380,8 @@ void band_step_equals_restrict_and_sweep(Op op, bool body_force) {
   auto [cg, fg] = two_blocks<D>(n, Vec<D>::Zero(), 4, 10);
   Op fine_op = op;
   fine_op.tau = 0.5 + 2.0 * (op.tau - 0.5);
-  refinement::TwoLevel<L, T> tl(cg, fg, {op.tau, op.tau_minus()}, {fine_op.tau, fine_op.tau_minus()});
+  refinement::TwoLevel<L, T> tl(cg, fg, {op.tau, op.tau_minus(), op.tau_bulk(D)},
+                                {fine_op.tau, fine_op.tau_minus(), fine_op.tau_bulk(D)}, collision::has_bulk_mode<Op>);
   field::Populations<L, T> coarse(cg), fine(fg);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> small(-0.01, 0.01);
@@ -347,6 +426,10 @@ TEST(TwoLevel, BandStepEqualsRestrictAndSweep2D) {
 TEST(TwoLevel, BandStepEqualsRestrictAndSweep3D) {
   band_step_equals_restrict_and_sweep<lattice::D3Q19, float>(collision::Trt{0.9, 0.25}, false);
   band_step_equals_restrict_and_sweep<lattice::D3Q19, double>(collision::Trt{0.9, 0.25}, true);
+}
+TEST(TwoLevel, BandStepEqualsRestrictAndSweepTrtBulk) {
+  band_step_equals_restrict_and_sweep<lattice::D2Q9, double>(collision::TrtBulk{0.8, 0.25, 15.0}, true);
+  band_step_equals_restrict_and_sweep<lattice::D3Q19, double>(collision::TrtBulk{0.9, 0.25, 15.0}, false);
 }
 
 // The tests run on one OpenMP thread (tests/CMakeLists.txt); this one checks that the threaded

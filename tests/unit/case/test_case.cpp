@@ -390,6 +390,23 @@ TEST(case_rejects, MagicWithBgk) {
                        "set by --set numerics.collision.magic=0.25"});
 }
 
+TEST(case_overrides, BulkViscosityRatioWithEitherOperator) {
+  for (const char* op : {"trt", "bgk"}) {
+    const CaseSpec spec = load_case(cylinder_file, "quick",
+                                    {std::string("numerics.collision.operator=") + op,
+                                     "numerics.collision.bulk_viscosity_ratio=30"});
+    ASSERT_TRUE(spec.numerics.collision.bulk_viscosity_ratio.has_value()) << op;
+    EXPECT_DOUBLE_EQ(*spec.numerics.collision.bulk_viscosity_ratio, 30.0);
+  }
+  EXPECT_FALSE(load_case(cylinder_file, "quick", {}).numerics.collision.bulk_viscosity_ratio.has_value());
+}
+
+TEST(case_rejects, BulkViscosityRatioOutOfRange) {
+  for (const char* value : {"0", "-2", "20000"})
+    expect_set_rejected({std::string("numerics.collision.bulk_viscosity_ratio=") + value},
+                        "/numerics/collision/bulk_viscosity_ratio", {"in (0, 10000]"});
+}
+
 TEST(case_rejects, DirectionForANonUniformFlowAndZeroDirection) {
   expect_set_rejected({"physics.flow.type=rest"}, "/physics/flow/direction",
                       {"applies only when", "\"uniform\""});

@@ -262,6 +262,71 @@ TYPED_TEST(PointwiseTest, TrtWithEqualRatesIsBgk) {
   }
 }
 
+TYPED_TEST(PointwiseTest, TrtBulkConservesMassAndMomentumAndAddsForce) {
+  using L = typename TypeParam::L;
+  using T = typename TypeParam::T;
+  check_collision_conservation<L, T>(TrtBulk{0.7, 0.25, 10.0}, 25);
+  check_collision_conservation<L, T>(TrtBulk{1.6, 3.0 / 16.0, 0.3}, 26);
+  check_collision_conservation<L, T>(TrtBulk{0.9, 0.25, 50.0, true}, 27);
+}
+
+TYPED_TEST(PointwiseTest, BulkShapeIsTheTracePartOfTheSecondMoment) {
+  using L = typename TypeParam::L;
+  double g[L::q];
+  for (int i = 0; i < L::q; ++i) g[i] = bulk_shape<L>(i);
+  const auto s = sums<L>(g);
+  EXPECT_NEAR(s.m0, 0.0, 1e-15);
+  for (int a = 0; a < L::d; ++a) {
+    EXPECT_NEAR(s.m1[a], 0.0, 1e-15);
+    for (int b = 0; b < L::d; ++b) EXPECT_NEAR(s.m2[a][b], a == b ? 1.0 / L::d : 0.0, 1e-15) << a << b;
+  }
+  EXPECT_NEAR(second_moment_trace<L>(g), 1.0, 1e-15);
+}
+
+// Bulk ratio 2/D is the base operator; otherwise only the trace of the second moment of the
+// non-equilibrium part (and of the source) relaxes differently: the shear stress is the base's,
+// and the post-collision trace follows (1 − ω_b) Π_neq + (1 − ω_b/2) Π_S.
+TYPED_TEST(PointwiseTest, TrtBulkRelaxesOnlyTheTraceOnItsOwn) {
+  using L = typename TypeParam::L;
+  using T = typename TypeParam::T;
+  constexpr int D = L::d;
+  std::mt19937 rng(32);
+  for (const double tau : {0.6, 1.3}) {
+    const Trt trt{tau, 0.25};
+    const TrtBulk same{tau, 0.25, 2.0 / D};
+    ASSERT_NEAR(same.tau_bulk(D), tau, 1e-14);
+    const TrtBulk bulk{tau, 0.25, 12.0};
+    const double wb = 1.0 / bulk.tau_bulk(D);
+    for (int sample = 0; sample < 50; ++sample) {
+      T f[L::q], a[L::q], b[L::q], c[L::q];
+      random_populations<L, T>(rng, f);
+      const auto F = random_vector<L, T>(rng, 0.02);
+      for (const T* force : {static_cast<const T*>(nullptr), F.data()}) {
+        collide_node<L, T>(trt, f, force, a);
+        collide_node<L, T>(same, f, force, b);
+        collide_node<L, T>(bulk, f, force, c);
+        for (int i = 0; i < L::q; ++i) EXPECT_NEAR(a[i], b[i], tol<T>) << "tau " << tau << " i=" << i;
+        const auto sa = sums<L>(a), sc = sums<L>(c);
+        for (int x = 0; x < D; ++x)
+          for (int y = 0; y < D; ++y)
+            if (x != y) {
+              EXPECT_NEAR(sc.m2[x][y], sa.m2[x][y], tol<T>) << "shear " << x << y;
+            }
+        // The trace: Π(out) = Π(feq) + (1 − ω_b) Π(f − feq) + (1 − ω_b/2) Π(S).
+        T feq[L::q], s[L::q] = {}, neq[L::q];
+        const auto m = moments<L, T>(f, force);
+        equilibrium<L, T>(m.rho, m.u, feq);
+        if (force) guo_source<L, T>(m.u, force, s);
+        for (int i = 0; i < L::q; ++i) neq[i] = f[i] - feq[i];
+        const double expected = double(second_moment_trace<L, T>(feq)) + (1 - wb) * second_moment_trace<L, T>(neq) +
+                                (1 - 0.5 * wb) * second_moment_trace<L, T>(s);
+        const double trace = second_moment_trace<L, T>(c);
+        EXPECT_NEAR(trace, expected, 4 * tol<T>) << "tau " << tau << (force ? " forced" : "");
+      }
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------
 // 4: streaming is a permutation
 

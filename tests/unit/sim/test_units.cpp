@@ -224,14 +224,14 @@ TEST(sim_units, NoCatalogueMembraneIsAboveTheExplicitCouplingLimit) {
 TEST(TauNearHalfCause, NamesTheChangeForTheOperator) {
   using Op = cases::CollisionSpec::Operator;
   const double tau = 0.51875;  // the cylinder at Re 200, quick, coarse block
-  const std::string bgk = tau_near_half_cause({Op::bgk, 0.25}, tau);
+  const std::string bgk = tau_near_half_cause({Op::bgk, 0.25, {}}, tau);
   EXPECT_NE(bgk.find("use the TRT operator"), std::string::npos) << bgk;
 
-  const std::string trt = tau_near_half_cause({Op::trt, 1.0 / 12}, tau);
+  const std::string trt = tau_near_half_cause({Op::trt, 1.0 / 12, {}}, tau);
   EXPECT_NE(trt.find("tau- = 1/2 + magic / (tau - 1/2) = 4.94"), std::string::npos) << trt;
   EXPECT_NE(trt.find("down to (tau - 1/2)/2 = 0.00938, which gives tau- = 1"), std::string::npos) << trt;
 
-  const std::string small = tau_near_half_cause({Op::trt, 0.005}, tau);
+  const std::string small = tau_near_half_cause({Op::trt, 0.005, {}}, tau);
   EXPECT_EQ(small.find("a smaller numerics.collision.magic"), std::string::npos) << small;
   EXPECT_NE(small.find("already relax fast here (magic 0.005, tau- = 0.767)"), std::string::npos) << small;
 
