@@ -126,12 +126,14 @@ struct TrtBulk {
   bool bgk = false;         // odd part with τ, as BGK
   static constexpr const char* name = "trt_bulk";
 
-  /// Both times computed, one chosen: a conditional division inside the kernel's vector loop
-  /// (it is evaluated there, on op's copy) stops GCC 12 from vectorizing it.
-  double tau_minus() const {
-    const double trt = 0.5 + magic / (tau - 0.5);
-    return bgk ? tau : trt;
+  /// The base operator: TRT, or BGK as TRT with Λ = (τ − ½)² (τ− = τ). Both Λ computed, one
+  /// chosen: a conditional division inside the kernel's vector loop (the operator is evaluated
+  /// there, on the kernel's copy) stops GCC 12 from vectorizing it.
+  Trt base() const {
+    const double bgk_magic = (tau - 0.5) * (tau - 0.5);
+    return {tau, bgk ? bgk_magic : magic};
   }
+  double tau_minus() const { return base().tau_minus(); }
   double tau_bulk(int dims) const { return 0.5 + 0.5 * dims * bulk_ratio * (tau - 0.5); }
 
   template <class L, class T>
@@ -143,34 +145,29 @@ struct TrtBulk {
   }
   /// The same with Π given (a refinement ghost, whose populations are not all at hand).
   template <class L, class T>
-  [[gnu::always_inline]] inline void collide_with_trace(const T (&f)[L::q], const T (&feq)[L::q], T trace, T (&out)[L::q]) const {
-    const T wp = T(1.0 / tau), wm = T(1.0 / tau_minus()), wb = T(1.0 / tau_bulk(L::d));
-    const T bulk = (wb - wp) * trace;
-#pragma GCC unroll 19
-    for (int i = 0; i < L::q; ++i) {
-      const int o = L::opposite[i];
-      const T np = T(0.5) * ((f[i] - feq[i]) + (f[o] - feq[o]));
-      const T nm = T(0.5) * ((f[i] - feq[i]) - (f[o] - feq[o]));
-      out[i] = f[i] - wp * np - wm * nm - T(bulk_shape<L>(i)) * bulk;
-    }
+  [[gnu::always_inline]] inline void collide_with_trace(const T (&f)[L::q], const T (&feq)[L::q], T trace,
+                                                        T (&out)[L::q]) const {
+    base().template collide<L, T>(f, feq, out);
+    subtract_bulk<L, T>(trace, out);
   }
   template <class L, class T>
-  [[gnu::always_inline]] inline void collide(const T (&f)[L::q], const T (&feq)[L::q], const T (&s)[L::q], T (&out)[L::q]) const {
-    const T wp = T(1.0 / tau), wm = T(1.0 / tau_minus()), wb = T(1.0 / tau_bulk(L::d));
-    const T sp = T(1) - T(0.5) * wp, sm = T(1) - T(0.5) * wm;
+  [[gnu::always_inline]] inline void collide(const T (&f)[L::q], const T (&feq)[L::q], const T (&s)[L::q],
+                                             T (&out)[L::q]) const {
     T neq[L::q];
 #pragma GCC unroll 19
     for (int i = 0; i < L::q; ++i) neq[i] = f[i] - feq[i];
+    base().template collide<L, T>(f, feq, s, out);
     // −(ω_b − ω+) β Π(f_neq) and ((1 − ω_b/2) − (1 − ω+/2)) β Π(S) in one term.
-    const T bulk = (wb - wp) * (second_moment_trace<L, T>(neq) + T(0.5) * second_moment_trace<L, T>(s));
+    subtract_bulk<L, T>(second_moment_trace<L, T>(neq) + T(0.5) * second_moment_trace<L, T>(s), out);
+  }
+
+ private:
+  /// out_i −= (ω_b − ω+) β_i Π.
+  template <class L, class T>
+  [[gnu::always_inline]] inline void subtract_bulk(T trace, T (&out)[L::q]) const {
+    const T bulk = (T(1.0 / tau_bulk(L::d)) - T(1.0 / tau)) * trace;
 #pragma GCC unroll 19
-    for (int i = 0; i < L::q; ++i) {
-      const int o = L::opposite[i];
-      const T np = T(0.5) * (neq[i] + neq[o]);
-      const T nm = T(0.5) * (neq[i] - neq[o]);
-      out[i] = f[i] - wp * np - wm * nm + sp * T(0.5) * (s[i] + s[o]) + sm * T(0.5) * (s[i] - s[o]) -
-               T(bulk_shape<L>(i)) * bulk;
-    }
+    for (int i = 0; i < L::q; ++i) out[i] -= T(bulk_shape<L>(i)) * bulk;
   }
 };
 

@@ -36,9 +36,9 @@
 // (D + 1 values) and the populations that enter through the face and their opposites (2E);
 // 14 of 19 values in D3Q19 (9 of 9 in D2Q9), 4 + 5 of them with BGK, whose rescaling and
 // collision need no opposite; with a bulk mode of its own also the trace of the second moment
-// (the ghost's Π, which the kept populations alone do not give). The moments and the interpolation are linear, so interpolated
-// moments are the moments of the interpolated populations (to round-off): the ghosts' ρ and u
-// come from them.
+// (the ghost's Π, which the kept populations alone do not give). The moments and the
+// interpolation are linear, so interpolated moments are the moments of the interpolated
+// populations (to round-off): the ghosts' ρ and u come from them.
 //
 // One coarse step: collide_band(), the coarse collide-push (in place, parity flip) +
 // boundaries, capture_coarse(); two fine substeps, each: collide-push, fill_fine_ghosts(s) with
@@ -279,7 +279,8 @@ class TwoLevel {
                       std::ptrdiff_t k0) const {
     constexpr std::array<int, 2 * E> pops = channel_populations(Face);
     constexpr bool bulk = collision::has_bulk_mode<Op>;
-    constexpr int kept = std::min(kept_channels<Op>, C - 1) - (D + 1);  // 2E, or E without the opposites (BGK)
+    // 2E, or E without the opposites (BGK); the trace is not a population.
+    constexpr int kept = std::min(kept_channels<Op>, C - 1) - (D + 1);
     const T half_plus = T(0.5 * f_from_c_.plus), half_minus = T(0.5 * f_from_c_.minus);
     const T bulk_minus_plus = T(f_from_c_.bulk - f_from_c_.plus), s_bulk = T(f_from_c_.bulk);
     T post[Q][batch];
@@ -302,7 +303,8 @@ class TwoLevel {
         // The bulk part β_i Π of the even part rescaled with s_b, and the fine Π = s_b Π_c.
         const T trace = coarse_c[trace_channel][b] - collision::second_moment_trace<L, T>(feq);
 #pragma GCC unroll 10
-        for (int e = 0; e < kept; ++e) f[pops[e]] += bulk_minus_plus * T(collision::bulk_shape<L>(pops[e])) * trace;
+        for (int e = 0; e < kept; ++e)
+          f[pops[e]] += bulk_minus_plus * T(collision::bulk_shape<L>(pops[e])) * trace;
         op.template collide_with_trace<L, T>(f, feq, s_bulk * trace, out);
       } else {
         op.template collide<L, T>(f, feq, out);

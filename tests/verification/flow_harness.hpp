@@ -1,6 +1,9 @@
 // Small helpers shared by the verification tests: build a Fluid on a box and read fields.
 #pragma once
 
+#include <cmath>
+#include <vector>
+
 #include "collision/operators.hpp"
 #include "lattice/lattice.hpp"
 #include "sim/fluid.hpp"
@@ -35,6 +38,24 @@ double mass(const sim::Fluid<L, T, Op>& fluid, std::size_t b) {
     for (int i = 0; i < L::q; ++i) m += L::w[i] + blk.pop(i, n);
   });
   return m;
+}
+
+/// Decay rate (per sample) of a damped oscillation A(t) = e^{−Γt} cos(ωt + φ) sampled every
+/// step: the least-squares slope of log |A| through its extrema after `skip` samples, each
+/// located by a parabola through three samples (the extrema of |A| are π/ω apart, so the ratio
+/// of successive ones is e^{−Γπ/ω} for any Γ/ω). `extrema` returns how many were fitted.
+inline double damped_oscillation_rate(const std::vector<double>& A, int skip, int& extrema) {
+  double st = 0, sl = 0, stt = 0, stl = 0;
+  int m = 0;
+  for (std::size_t t = static_cast<std::size_t>(skip); t + 1 < A.size(); ++t) {
+    const double a = std::abs(A[t - 1]), b = std::abs(A[t]), c = std::abs(A[t + 1]);
+    if (!(b > a && b >= c)) continue;
+    const double dt = 0.5 * (a - c) / (a - 2 * b + c);  // vertex of the parabola, in samples
+    const double tp = static_cast<double>(t) + dt, lp = std::log(b - 0.25 * (a - c) * dt);
+    st += tp, sl += lp, stt += tp * tp, stl += tp * lp, ++m;
+  }
+  extrema = m;
+  return -(m * stl - st * sl) / (m * stt - st * st);
 }
 
 }  // namespace caplab::testing

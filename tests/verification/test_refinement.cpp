@@ -163,7 +163,9 @@ double sound_rate_through_interface(Op op, double bulk_ratio) {
   s.coarse_op = op;
   sim::Fluid<lattice::D2Q9, double, Op> fluid(s);
   const double kw = 2 * std::numbers::pi / n, eps = 1e-4;
-  fluid.initialise([&](const Vec<2>& x) { return std::pair{1.0 + eps * std::cos(kw * x[0]), Vec<2>::Zero().eval()}; });
+  fluid.initialise([&](const Vec<2>& x) {
+    return std::pair{1.0 + eps * std::cos(kw * x[0]), Vec<2>::Zero().eval()};
+  });
   auto amplitude = [&] {
     const auto& blk = fluid.block(0);
     double a = 0;
@@ -186,17 +188,9 @@ double sound_rate_through_interface(Op op, double bulk_ratio) {
     fluid.step();
     A.push_back(amplitude());
   }
-  double st = 0, sl = 0, stt = 0, stl = 0;
-  int m = 0;
-  for (int t = 50; t + 1 < steps; ++t) {  // extrema of |A|, parabola through three steps
-    const double a = std::abs(A[t - 1]), b = std::abs(A[t]), cc = std::abs(A[t + 1]);
-    if (!(b > a && b >= cc)) continue;
-    const double dt = 0.5 * (a - cc) / (a - 2 * b + cc);
-    const double tp = t + dt, lp = std::log(b - 0.25 * (a - cc) * dt);
-    st += tp, sl += lp, stt += tp * tp, stl += tp * lp, ++m;
-  }
-  EXPECT_GE(m, 6);
-  const double measured = -(m * stl - st * sl) / (m * stt - st * st);
+  int extrema = 0;
+  const double measured = testing::damped_oscillation_rate(A, 50, extrema);
+  EXPECT_GE(extrema, 6);
   return measured / rate;
 }
 
@@ -373,7 +367,7 @@ TEST(TwoLevel, FineGhostsAreNeverRead3D) {
 // uncovered coarse nodes what restricting the covered nodes and sweeping the whole block gives,
 // bit for bit, with and without a body force (the Guo-forced kernel).
 template <class L, class T, class Op>
-void band_step_equals_restrict_and_sweep(Op op, bool body_force) {
+void band_step_equals_restrict_and_sweep(Op op, bool body_force, double tolerance = 0.0) {
   constexpr int D = L::d, Q = L::q;
   Index<D> n;
   n.fill(14);
@@ -411,7 +405,7 @@ void band_step_equals_restrict_and_sweep(Op op, bool body_force) {
     field::for_each_interior<D>(cg, [&](const Index<D>& ijk) {
       if (tl.covered(ijk)) return;
       for (int i = 0; i < Q; ++i, ++compared)
-        differing += coarse(i, cg.index(ijk)) != reference(i, cg.index(ijk));
+        differing += !(std::abs(double(coarse(i, cg.index(ijk))) - double(reference(i, cg.index(ijk)))) <= tolerance);
     });
     EXPECT_GT(compared, 0U);
     EXPECT_EQ(differing, 0U) << "step " << step;
@@ -427,8 +421,11 @@ TEST(TwoLevel, BandStepEqualsRestrictAndSweep3D) {
   band_step_equals_restrict_and_sweep<lattice::D3Q19, float>(collision::Trt{0.9, 0.25}, false);
   band_step_equals_restrict_and_sweep<lattice::D3Q19, double>(collision::Trt{0.9, 0.25}, true);
 }
+// With TrtBulk the forced 2D case differs in a few values by 5e-18 (populations of order 1e-2):
+// GCC contracts TRT's source terms into fma differently in the vector kernel and in the band's
+// batch loop once the bulk term follows them. Equal to round-off, not bit for bit.
 TEST(TwoLevel, BandStepEqualsRestrictAndSweepTrtBulk) {
-  band_step_equals_restrict_and_sweep<lattice::D2Q9, double>(collision::TrtBulk{0.8, 0.25, 15.0}, true);
+  band_step_equals_restrict_and_sweep<lattice::D2Q9, double>(collision::TrtBulk{0.8, 0.25, 15.0}, true, 1e-16);
   band_step_equals_restrict_and_sweep<lattice::D3Q19, double>(collision::TrtBulk{0.9, 0.25, 15.0}, false);
 }
 
