@@ -28,6 +28,17 @@ Vec<L::d> velocity(const sim::Fluid<L, T, Op>& fluid, std::size_t b, const Index
   return u;
 }
 
+/// A fully periodic box of n nodes (spacing 1, origin 0) at rest, one block, operator op.
+template <class L, class T, class Op>
+typename sim::Fluid<L, T, Op>::Setup periodic_box(const Index<L::d>& n, const Op& op) {
+  typename sim::Fluid<L, T, Op>::Setup s;
+  s.coarse = field::Grid<L::d>(n, Vec<L::d>::Zero(), 1.0);
+  s.boundaries.fill(boundary::Kind::periodic);
+  s.imposed_velocity_lu = [](const Vec<L::d>&) { return Vec<L::d>::Zero(); };
+  s.coarse_op = op;
+  return s;
+}
+
 /// Total mass Σρ over the interior of block b.
 template <class L, class T, class Op>
 double mass(const sim::Fluid<L, T, Op>& fluid, std::size_t b) {

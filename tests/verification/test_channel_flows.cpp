@@ -102,12 +102,7 @@ void taylor_green(int a, int b, Op op) {
   nn.fill(D == 3 ? 4 : n);
   nn[a] = n;
   nn[b] = n;
-  typename sim::Fluid<L, double, Op>::Setup s;
-  s.coarse = field::Grid<D>(nn, Vec<D>::Zero(), 1.0);
-  s.boundaries.fill(Kind::periodic);
-  s.imposed_velocity_lu = [](const Vec<D>&) { return Vec<D>::Zero(); };
-  s.coarse_op = op;
-  sim::Fluid<L, double, Op> fluid(s);
+  sim::Fluid<L, double, Op> fluid(testing::periodic_box<L, double>(nn, op));
   const double kw = 2 * std::numbers::pi / n, u0 = 0.01;
   fluid.initialise([&](const Vec<D>& x) {
     Vec<D> u = Vec<D>::Zero();
@@ -153,12 +148,7 @@ void sound_attenuation(Op op, double bulk_ratio) {
   Index<D> nn;
   nn.fill(4);
   nn[0] = n;
-  typename sim::Fluid<L, double, Op>::Setup s;
-  s.coarse = field::Grid<D>(nn, Vec<D>::Zero(), 1.0);
-  s.boundaries.fill(Kind::periodic);
-  s.imposed_velocity_lu = [](const Vec<D>&) { return Vec<D>::Zero(); };
-  s.coarse_op = op;
-  sim::Fluid<L, double, Op> fluid(s);
+  sim::Fluid<L, double, Op> fluid(testing::periodic_box<L, double>(nn, op));
   const double kw = 2 * std::numbers::pi / n, eps = 1e-4;
   fluid.initialise([&](const Vec<D>& x) {
     return std::pair{1.0 + eps * std::cos(kw * x[0]), Vec<D>::Zero().eval()};
