@@ -9,7 +9,6 @@
 // sound. All work on shifted populations (see field/populations.hpp).
 #pragma once
 
-#include <array>
 #include <cmath>
 #include <type_traits>
 
