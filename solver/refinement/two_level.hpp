@@ -117,6 +117,7 @@ class TwoLevel {
   /// the older levels.
   template <class Op>
   void capture_coarse(const field::Populations<L, T>& coarse) {
+    check_operator<Op>();
     newest_ = (newest_ + 1) % 3;
     store_level<kept_channels<Op>>(coarse, newest_);
     if (!primed_) {
@@ -131,6 +132,7 @@ class TwoLevel {
   /// coarse level t_n.
   template <class Op>
   void fill_fine_ghosts(field::Populations<L, T>& fine, const Op& op_fine, double s) {
+    check_operator<Op>();
     // 3-point Lagrange through t_{n-1} = −1, t_n = 0, t_{n+1} = 1 (eq. 2.14).
     const T lag[3] = {T(0.5 * s * (s - 1.0)), T((1.0 - s) * (1.0 + s)), T(0.5 * s * (s + 1.0))};
     const std::size_t S = sources_.size();
@@ -197,6 +199,7 @@ class TwoLevel {
   template <bool Forced, class Op>
   void collide_band(field::Populations<L, T>& coarse, const field::Populations<L, T>& fine, const Op& op,
                     const T (&F)[D]) const {
+    check_operator<Op>();
     const std::array<T*, Q> dst = coarse.bases();
     auto collide = [=](const T(&f)[Q], T(&out)[Q]) __attribute__((always_inline)) {  // F, op copied
       collision::collide_node<Forced, L, T>(f, F, op, out);  // as the sweep would
@@ -634,6 +637,14 @@ class TwoLevel {
 
   /// Channels per level in the history: the trace only when the operator reads it.
   std::size_t stored_channels() const { return trace_ ? C : C - 1; }
+  /// The history's layout was fixed at construction (`trace`): an operator of the other kind
+  /// would read or write the trace channel outside it.
+  template <class Op>
+  void check_operator() const {
+    CAPLAB_CHECK(collision::has_bulk_mode<Op> == trace_,
+                 "two-level coupling constructed for an operator with(out) a bulk mode of its own, used with the "
+                 "other kind: pass collision::has_bulk_mode<Op> as `trace`");
+  }
 
   field::Grid<D> coarse_, fine_;
   Taus c_from_f_{1.0, 1.0, 1.0}, f_from_c_{1.0, 1.0, 1.0};  // rescaling factors of the even, odd, bulk parts

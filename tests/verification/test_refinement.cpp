@@ -429,6 +429,21 @@ TEST(TwoLevel, BandStepEqualsRestrictAndSweepTrtBulk) {
   band_step_equals_restrict_and_sweep<lattice::D3Q19, double>(collision::TrtBulk{0.9, 0.25, 15.0}, false);
 }
 
+// The history's layout follows the operator given at construction; the other kind is refused
+// before it reads or writes outside it.
+TEST(TwoLevel, OperatorOfTheOtherKindIsRefused) {
+  Index<2> n;
+  n.fill(14);
+  auto [cg, fg] = two_blocks<2>(n, Vec<2>::Zero(), 4, 10);
+  refinement::TwoLevel<lattice::D2Q9, double> plain(cg, fg, {0.8, 0.8, 0.8}, {1.1, 1.1, 1.1}, false);
+  refinement::TwoLevel<lattice::D2Q9, double> bulk(cg, fg, {0.8, 0.8, 3.0}, {1.1, 1.1, 5.5}, true);
+  field::Populations<lattice::D2Q9, double> coarse(cg);
+  EXPECT_NO_THROW(plain.capture_coarse<collision::Trt>(coarse));
+  EXPECT_NO_THROW(bulk.capture_coarse<collision::TrtBulk>(coarse));
+  EXPECT_ANY_THROW(plain.capture_coarse<collision::TrtBulk>(coarse));
+  EXPECT_ANY_THROW(bulk.capture_coarse<collision::Trt>(coarse));
+}
+
 // The tests run on one OpenMP thread (tests/CMakeLists.txt); this one checks that the threaded
 // kernels, the two-level transfers included, give the same populations bit for bit.
 TEST(TwoLevel, PopulationsDoNotDependOnThreadCount) {
