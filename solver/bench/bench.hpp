@@ -5,7 +5,7 @@
 //     the fluid runs; the better of the two is used.
 //  2. MLUPS of sim::Fluid::step() on a periodic box (fluid_throughput.hpp) for every selected
 //     lattice × collision × precision × thread count, and the two-level case per lattice ×
-//     thread count (first selected collision and precision) with its overhead against the
+//     precision × thread count (first selected collision) with its overhead against the
 //     uniform box of the same configuration.
 //  3. Roofline per row: bytes per node update B_u = Populations::bytes_per_update() = 2 Q
 //     sizeof(T) (the in-place kernel reads a node's Q values and writes them back), roofline
