@@ -365,9 +365,10 @@ TEST(TwoLevel, FineGhostsAreNeverRead3D) {
 // The band's step taken by the coupling (collide_band: restricted, collided, pushed along the
 // links that leave the covered region, the coarse sweep skipping the covered region) gives the
 // uncovered coarse nodes what restricting the covered nodes and sweeping the whole block gives,
-// bit for bit, with and without a body force (the Guo-forced kernel).
+// bit for bit, with and without a body force (the Guo-forced kernel); `max_ulps` > 0 only where
+// the two loops round differently (said at the call).
 template <class L, class T, class Op>
-void band_step_equals_restrict_and_sweep(Op op, bool body_force, double tolerance = 0.0) {
+void band_step_equals_restrict_and_sweep(Op op, bool body_force, int max_ulps = 0) {
   constexpr int D = L::d, Q = L::q;
   Index<D> n;
   n.fill(14);
@@ -402,13 +403,24 @@ void band_step_equals_restrict_and_sweep(Op op, bool body_force, double toleranc
       collision::stream_collide<false>(coarse, op, nullptr, tl.idle_coarse());
     }
     std::size_t compared = 0, differing = 0;
+    // The difference in units in the last place of the node's largest population: the scale of
+    // the terms a population is summed from (a population near zero is a cancellation).
+    double worst_ulps = 0;
     field::for_each_interior<D>(cg, [&](const Index<D>& ijk) {
       if (tl.covered(ijk)) return;
-      for (int i = 0; i < Q; ++i, ++compared)
-        differing += !(std::abs(double(coarse(i, cg.index(ijk))) - double(reference(i, cg.index(ijk)))) <= tolerance);
+      T m = 0;
+      for (int i = 0; i < Q; ++i) m = std::max(m, std::abs(reference(i, cg.index(ijk))));
+      const double ulp = double(std::nextafter(m, T(1)) - m);
+      for (int i = 0; i < Q; ++i, ++compared) {
+        const T a = coarse(i, cg.index(ijk)), b = reference(i, cg.index(ijk));
+        if (a == b) continue;
+        const double ulps = std::abs(double(a) - double(b)) / ulp;
+        worst_ulps = std::max(worst_ulps, ulps);
+        differing += !(ulps <= max_ulps);
+      }
     });
     EXPECT_GT(compared, 0U);
-    EXPECT_EQ(differing, 0U) << "step " << step;
+    EXPECT_EQ(differing, 0U) << "step " << step << ": up to " << worst_ulps << " ulps apart (allowed " << max_ulps << ")";
     coarse = reference;  // the next step from the same state
   }
 }
@@ -421,11 +433,12 @@ TEST(TwoLevel, BandStepEqualsRestrictAndSweep3D) {
   band_step_equals_restrict_and_sweep<lattice::D3Q19, float>(collision::Trt{0.9, 0.25}, false);
   band_step_equals_restrict_and_sweep<lattice::D3Q19, double>(collision::Trt{0.9, 0.25}, true);
 }
-// With TrtBulk the forced 2D case differs in a few values by 5e-18 (populations of order 1e-2):
-// GCC contracts TRT's source terms into fma differently in the vector kernel and in the band's
-// batch loop once the bulk term follows them. Equal to round-off, not bit for bit.
+// With TrtBulk the forced 2D case differs in a few values by up to 6 ulps of the node's largest
+// population (5e-18 on populations of order 1e-2): GCC contracts TRT's source terms into fma differently in the vector kernel and in
+// the band's batch loop once the bulk term follows them (explicit std::fma in the bulk term and
+// the transfers did not change that). Equal to round-off, not bit for bit.
 TEST(TwoLevel, BandStepEqualsRestrictAndSweepTrtBulk) {
-  band_step_equals_restrict_and_sweep<lattice::D2Q9, double>(collision::TrtBulk{0.8, 0.25, 15.0}, true, 1e-16);
+  band_step_equals_restrict_and_sweep<lattice::D2Q9, double>(collision::TrtBulk{0.8, 0.25, 15.0}, true, 8);
   band_step_equals_restrict_and_sweep<lattice::D3Q19, double>(collision::TrtBulk{0.9, 0.25, 15.0}, false);
 }
 
