@@ -7,12 +7,15 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <utility>
 
 #include "core/error.hpp"
+#include "diagnostics/capsule_motion.hpp"
 #include "io/run_directory.hpp"
 #include "io/series_writer.hpp"
 #include "score/comparators.hpp"
@@ -160,6 +163,7 @@ const std::vector<double>* series_column(Run& run, const std::string& metric) {
     try {
       if (fs::is_regular_file(file, ec)) {
         auto data = io::read_series(file);
+        if (data.count("t")) run.series->emplace("t", data["t"]);
         for (const auto& c : io::read_series_columns(file))
           for (const char* name : kSeries)
             if (c.name == name ||
@@ -303,6 +307,82 @@ KindResult check_mode(const json& claim, const std::vector<Chosen>& ok, json& ro
     row["verdict"] = verdict_json(cmp.pass && c.wrong.empty());
     if (!cmp.pass) row["note"] = mode.empty() ? "no mode in summary.json" : cmp.message;
     if (cmp.pass && !c.wrong.empty()) row["note"] = "not about this claim: " + join(c.wrong, "; ");
+    if (row["verdict"] == "fail") failures.push_back(c.run->label() + ": " + row["note"].get<std::string>());
+  }
+  return from_rows(rows, ok, failures);
+}
+
+/// Reversals of the inclination in the last stage of a time sequence: two whole swings.
+constexpr int kSequenceReversals = 4;
+
+/// A sequence of regimes within each run (claims.hpp, "sequence"); judged for tumbling, then
+/// swinging, from the series inclination (continuous, rad): the last stage follows the end of
+/// the last turn through pi.
+KindResult check_time_sequence(const json& claim, const std::vector<Chosen>& ok, json& rows) {
+  const json& sequence = member(claim, "sequence");
+  if (sequence != json{"tumbling", "oscillating_tank_treading"})
+    return {Outcome::not_checkable,
+            "of the time sequences only [\"tumbling\", \"oscillating_tank_treading\"] is judged"};
+  std::vector<std::string> failures;
+  for (const auto& c : ok) {
+    json& row = rows[c.row];
+    const std::vector<double>* t = series_column(*c.run, "t");
+    const std::vector<double>* theta = series_column(*c.run, "inclination");
+    if (!t || !theta || t->size() != theta->size() ||
+        !std::all_of(theta->begin(), theta->end(), [](double v) { return std::isfinite(v); })) {
+      row["note"] = "no finite series inclination (with t) in series.h5";
+      continue;
+    }
+    const std::size_t n = theta->size();
+    std::size_t start = n;  // the first sample of the last stage
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (std::size_t i = n; i-- > 0; start = i) {
+      lo = std::min(lo, (*theta)[i]);
+      hi = std::max(hi, (*theta)[i]);
+      if (hi - lo >= std::numbers::pi) break;
+    }
+    const json& threshold = member(member(c.run->case_doc, "outputs"), "oscillation_threshold");
+    const double threshold_rad = finite(threshold) ? threshold.get<double>() * std::numbers::pi / 180
+                                                   : diagnostics::default_oscillation_threshold;
+    // That suffix still holds the end of the last turn: the last stage starts where the turn
+    // ends, at its extreme once the inclination has come back from it by more than twice the
+    // threshold (a swing's first reversal); without one it is the whole suffix.
+    if (start > 0) {
+      const double way = (*theta)[start] < (*theta)[0] ? -1.0 : 1.0;  // the direction of the turn
+      std::size_t extreme = start;
+      for (std::size_t k = start + 1; k < n; ++k) {
+        if (way * ((*theta)[k] - (*theta)[extreme]) > 0) extreme = k;
+        if (way * ((*theta)[extreme] - (*theta)[k]) > 2 * threshold_rad) {
+          start = extreme;
+          break;
+        }
+      }
+    }
+    if (start == 0 || n - start < 3) {
+      row["verdict"] = "fail";
+      row["note"] = start == 0 ? "no initial tumbling: the inclination spans less than pi over the whole run"
+                               : "too few samples after the inclination's last turn through pi";
+      failures.push_back(c.run->label() + ": " + row["note"].get<std::string>());
+      continue;
+    }
+    const auto [first_lo, first_hi] = std::minmax_element(theta->begin(), theta->begin() + start + 1);
+    const diagnostics::CapsuleMotion last =
+        diagnostics::classify_capsule_motion(*t, *theta, (*t)[start], threshold_rad);
+    const bool swings =
+        last.mode == "oscillating_tank_treading" && last.inclination_reversals >= kSequenceReversals;
+    row["parameter"] = (*t)[start];
+    row["value"] = fmt::format(
+        "turned {:.3g} rad up to t = {:.4g}, then {} ({} reversals, half range {:.3g} degrees) to t = {:.4g}",
+        *first_hi - *first_lo, (*t)[start], last.mode, last.inclination_reversals,
+        last.inclination_amplitude * 180 / std::numbers::pi, t->back());
+    row["verdict"] = verdict_json(swings && c.wrong.empty());
+    if (!swings)
+      row["note"] = fmt::format(
+          "the last stage (from t = {:.4g}) is {}, not swinging ({} reversals of more than {:.3g} degrees; {} "
+          "needed)",
+          (*t)[start], last.mode, last.inclination_reversals, 2 * threshold_rad * 180 / std::numbers::pi,
+          kSequenceReversals);
+    if (swings && !c.wrong.empty()) row["note"] = "not about this claim: " + join(c.wrong, "; ");
     if (row["verdict"] == "fail") failures.push_back(c.run->label() + ": " + row["note"].get<std::string>());
   }
   return from_rows(rows, ok, failures);
@@ -528,13 +608,18 @@ json evaluate_claim(const json& claim, std::vector<Run>& runs) {
 
   // Not checkable whatever the runs say (a run naming such a claim is not judged either).
   std::string immune;
+  const bool time_sequence =
+      kind == "trend" && member(claim, "varying") == "time" && member(claim, "sequence").is_array();
   if (kind == "value") immune = "a value statement: the runs' values are listed, not judged";
-  if ((kind == "trend" || kind == "bound") && !has_metric) immune = "no \"metric\": not in summary.json";
+  if ((kind == "trend" || kind == "bound") && !has_metric && !time_sequence)
+    immune = "no \"metric\": not in summary.json";
 
   KindResult result;
   if (kind == "mode") result = check_mode(claim, ok, rows);
   if (kind == "bracket") result = check_bracket(claim, ok, rows);
-  if (kind == "trend" && has_metric) {
+  if (time_sequence) {
+    result = check_time_sequence(claim, ok, rows);
+  } else if (kind == "trend" && has_metric) {
     out["series"] = json::array();
     result = check_trend(claim, ok, rows, out["series"]);
   }

@@ -46,13 +46,24 @@
 //            "direction": increasing / decreasing (strict; for "metric": "mode", the regimes
 //            ordered steady_tank_treading < oscillating_tank_treading < tumbling, non-strict),
 //            "sequence" (non-decreasing), "approaches" with a numeric "limit" (|v − limit|
-//            decreasing). Consistent when no decided series fails and one passes;
+//            decreasing). Consistent when no decided series fails and one passes.
+//            With "varying": "time" and "sequence": ["tumbling", "oscillating_tank_treading"]
+//            (no "metric" needed) a sequence of regimes within each run, judged per run on the
+//            series inclination (continuous, with t): the last stage starts where the last turn
+//            through pi ends ("parameter": that time), i.e. in the longest end of the run over
+//            which the inclination spans less than pi, at the extreme of the turn's direction
+//            from which it first comes back by more than twice the case's threshold (the whole
+//            end when it never does); the run passes when it turned through pi before (an initial tumbling) and
+//            the last stage swings (diagnostics::classify_capsule_motion from there, with the
+//            case's outputs.oscillation_threshold: oscillating_tank_treading with at least 4
+//            reversals, two whole swings); "value" says what was found. Other sequences are not
+//            checked;
 //   bound    "lower" / "upper" (exclusive when "strict"), each run; "quantifier": "some"
 //            needs one run inside, the others are listed unjudged; a bound without a number
 //            is not checked;
 //   value    the runs' metric is listed, never judged.
-// A trend or bound without "metric", a trend with several "varying" parameters or another
-// "direction", and every value claim are "not checked".
+// A trend (but a time sequence) or bound without "metric", a trend with several "varying"
+// parameters or another "direction", and every value claim are "not checked".
 //
 // Verdict of a claim, in this order: "not checked" for a value claim or a trend or bound
 // without "metric"; "inconsistent" when a named run is not about the claim or the check fails

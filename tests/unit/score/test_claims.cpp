@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -288,6 +289,67 @@ TEST_F(ScoreClaims, RegimeSequenceAndApproachingTrends) {
   EXPECT_EQ(check(approaches, f)["verdict"], "consistent");
   approaches["limit"] = 0.0;
   EXPECT_EQ(check(approaches, f)["verdict"], "inconsistent");
+}
+
+/// Writes series.h5 with t and the continuous inclination theta(t) into run directory `d`.
+void write_inclination(const fs::path& d, const std::vector<double>& t, double (*theta)(double)) {
+  io::SeriesWriter w(d / "series.h5", {{"t", "1/k", "time"}, {"inclination", "rad", "inclination"}});
+  for (double x : t) {
+    const double row[2] = {x, theta(x)};
+    w.append(row);
+  }
+  w.close();
+}
+
+// "Initial tumbling, then swinging" (thesis 6.3.2 at G = 0.015) judged on each run's series: the
+// last stage starts where the inclination stops spanning pi; it must have turned through pi
+// before and swing (two whole swings) after. Each way of missing the sequence fails.
+TEST_F(ScoreClaims, TimeSequenceOfTumblingThenSwinging) {
+  const json claim = {{"id", "t.sequence"},
+                      {"kind", "trend"},
+                      {"parameters", {{"shape", "circle"}}},
+                      {"metric", nullptr},
+                      {"varying", "time"},
+                      {"direction", "initial tumbling, then swinging"},
+                      {"sequence", {"tumbling", "oscillating_tank_treading"}}};
+  std::vector<double> t;
+  for (int i = 0; i <= 1600; ++i) t.push_back(0.05 * i);  // k t 0-80
+  constexpr double rate = -std::numbers::pi / 9.8;          // half a turn every 9.8/k
+  const fs::path both = run("both", Capsule{}, {{"mode", "tumbling"}});
+  write_inclination(both, t, [](double x) {
+    return x < 53 ? rate * x : rate * 53 + 0.4 * std::sin(2 * std::numbers::pi * (x - 53) / 8.8);
+  });
+  const fs::path tumbles = run("tumbles", Capsule{}, {{"mode", "tumbling"}});
+  write_inclination(tumbles, t, [](double x) { return rate * x; });
+  const fs::path swings = run("swings", Capsule{}, {{"mode", "oscillating_tank_treading"}});
+  write_inclination(swings, t, [](double x) { return 0.4 * std::sin(2 * std::numbers::pi * x / 8.8); });
+  const fs::path stops = run("stops", Capsule{}, {{"mode", "tumbling"}});
+  write_inclination(stops, t, [](double x) { return rate * std::min(x, 53.0); });
+
+  const json c = check(claim, {both});
+  EXPECT_EQ(c["verdict"], "consistent") << c.dump(2);
+  const json row = run_row(c, "both");
+  EXPECT_EQ(row["verdict"], "pass");
+  // The last stage starts where the turn ends (t = 53, where the swing turns the inclination
+  // back up), with the swing's half range of 0.4 rad.
+  EXPECT_NEAR(row["parameter"].get<double>(), 53.0, 0.06);
+  EXPECT_NE(row["value"].get<std::string>().find("then oscillating_tank_treading"), std::string::npos);
+  EXPECT_NE(row["value"].get<std::string>().find("half range 22.9 degrees"), std::string::npos) << row.dump();
+
+  for (const auto& [name, note] : std::vector<std::pair<std::string, std::string>>{
+           {"tumbles", "is tumbling"}, {"swings", "no initial tumbling"}, {"stops", "0 reversals"}}) {
+    const json r = check(claim, {both, dir_ / "quick" / name});
+    EXPECT_EQ(r["verdict"], "inconsistent") << name;
+    EXPECT_EQ(run_row(r, name)["verdict"], "fail") << name;
+    EXPECT_NE(run_row(r, name)["note"].get<std::string>().find(note), std::string::npos) << r.dump(2);
+  }
+
+  json other = claim;
+  other["sequence"] = {"oscillating_tank_treading", "tumbling"};
+  EXPECT_EQ(check(other, {both})["verdict"], "not checked");
+  json plain = claim;  // without "sequence" a time trend stays unjudged
+  plain.erase("sequence");
+  EXPECT_EQ(check(plain, {both})["verdict"], "not checked");
 }
 
 TEST_F(ScoreClaims, BoundClaims) {
