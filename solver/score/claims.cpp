@@ -333,13 +333,15 @@ KindResult check_time_sequence(const json& claim, const std::vector<Chosen>& ok,
       row["note"] = "no finite series inclination (with t) in series.h5";
       continue;
     }
+    // The longest end of the run over which the inclination spans less than pi.
     const std::size_t n = theta->size();
-    std::size_t start = n;  // the first sample of the last stage
+    std::size_t start = n;  // its first sample
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (std::size_t i = n; i-- > 0; start = i) {
-      lo = std::min(lo, (*theta)[i]);
-      hi = std::max(hi, (*theta)[i]);
+    while (start > 0) {
+      lo = std::min(lo, (*theta)[start - 1]);
+      hi = std::max(hi, (*theta)[start - 1]);
       if (hi - lo >= std::numbers::pi) break;
+      --start;
     }
     const json& threshold = member(member(c.run->case_doc, "outputs"), "oscillation_threshold");
     const double threshold_rad = finite(threshold) ? threshold.get<double>() * std::numbers::pi / 180
