@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "diagnostics/turning_points.hpp"
 
 namespace caplab::diagnostics {
 
@@ -18,25 +19,6 @@ double AngleUnwrapper::operator()(double angle) {
 }
 
 namespace {
-
-// Turns of v by more than `swing` back from its extreme since the last turn (a zigzag
-// filter): 0 for a monotone signal, however it curves.
-int reversals(std::span<const double> v, double swing) {
-  int dir = 0, turns = 0;
-  double hi = v.front(), lo = v.front();
-  for (const double x : v) {
-    hi = std::max(hi, x);
-    lo = std::min(lo, x);
-    if (dir >= 0 && hi - x > swing) {  // fell from a maximum
-      if (dir > 0) ++turns;
-      dir = -1, hi = lo = x;
-    } else if (dir <= 0 && x - lo > swing) {  // rose from a minimum
-      if (dir < 0) ++turns;
-      dir = 1, hi = lo = x;
-    }
-  }
-  return turns;
-}
 
 // Whole turns of v by `turn` from v[first], in the sense v ends up moving, and the time the
 // last one completed (linear interpolation between samples).
@@ -84,7 +66,8 @@ CapsuleMotion classify_capsule_motion(std::span<const double> t, std::span<const
   m.inclination_turn = *hi_all - *lo_all;
   const auto [lo, hi] = std::minmax_element(inclination.begin() + first, inclination.end());
   m.inclination_amplitude = 0.5 * (*hi - *lo);
-  m.inclination_reversals = reversals(inclination.subspan(first), 2 * oscillation_threshold);
+  m.inclination_reversals =
+      static_cast<int>(turning_points(inclination.subspan(first), 2 * oscillation_threshold).size());
   const double span = t[last] - t[first];
   // Tumbling: the inclination turns through more than pi in the window, or it did over the run
   // and is still turning one way (a window shorter than a half-turn). A capsule that tumbled at

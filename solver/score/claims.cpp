@@ -16,6 +16,7 @@
 
 #include "core/error.hpp"
 #include "diagnostics/capsule_motion.hpp"
+#include "diagnostics/turning_points.hpp"
 #include "io/run_directory.hpp"
 #include "io/series_writer.hpp"
 #include "score/comparators.hpp"
@@ -346,20 +347,15 @@ KindResult check_time_sequence(const json& claim, const std::vector<Chosen>& ok,
     const json& threshold = member(member(c.run->case_doc, "outputs"), "oscillation_threshold");
     const double threshold_rad = finite(threshold) ? threshold.get<double>() * std::numbers::pi / 180
                                                    : diagnostics::default_oscillation_threshold;
-    // That suffix still holds the end of the last turn: the last stage starts where the turn
-    // ends, at its extreme once the inclination has come back from it by more than twice the
-    // threshold (a swing's first reversal); without one it is the whole suffix.
-    if (start > 0) {
-      const double way = (*theta)[start] < (*theta)[0] ? -1.0 : 1.0;  // the direction of the turn
-      std::size_t extreme = start;
-      for (std::size_t k = start + 1; k < n; ++k) {
-        if (way * ((*theta)[k] - (*theta)[extreme]) > 0) extreme = k;
-        if (way * ((*theta)[extreme] - (*theta)[k]) > 2 * threshold_rad) {
-          start = extreme;
+    // That suffix still holds the end of the last turn: the last stage starts at the turn's
+    // extreme, the first turning point in it (a swing's first reversal); without one it is the
+    // whole suffix.
+    if (start > 0)
+      for (const std::size_t k : diagnostics::turning_points(*theta, 2 * threshold_rad))
+        if (k >= start) {
+          start = k;
           break;
         }
-      }
-    }
     if (start == 0 || n - start < 3) {
       row["verdict"] = "fail";
       row["note"] = start == 0 ? "no initial tumbling: the inclination spans less than pi over the whole run"
