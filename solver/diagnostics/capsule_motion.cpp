@@ -14,8 +14,9 @@ double AngleUnwrapper::operator()(double angle) {
     started_ = true;
     return last_ = angle;
   }
-  const double d = angle - last_;
-  return last_ += d - period_ * std::round(d / period_);
+  // The measured angle plus whole periods, not a running sum of increments: the value depends on
+  // the angle and its branch alone, not on how often (or since when) the angle was sampled.
+  return last_ = angle + period_ * std::round((last_ - angle) / period_);
 }
 
 namespace {

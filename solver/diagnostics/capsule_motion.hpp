@@ -33,8 +33,9 @@
 namespace caplab::diagnostics {
 
 /// Turns a sequence of angles known modulo `period` into a continuous one: each value is the
-/// representative nearest to the previous one. Valid while consecutive samples move by less
-/// than period / 2.
+/// representative nearest to the previous one (the angle plus whole periods, so a value does not
+/// depend on the samples between: following every step or every tenth gives the same doubles).
+/// Valid while consecutive samples move by less than period / 2.
 class AngleUnwrapper {
  public:
   explicit AngleUnwrapper(double period) : period_(period) {}

@@ -46,6 +46,17 @@ struct CapsuleQuantity {
 template <int D>
 class CapsuleTrack;
 
+/// Longest time (L/U: 1/k in shear flow) between two shape updates of a capsule track. Its
+/// angles must move by less than half their period (pi/2 for the axis, pi for the tracked node)
+/// between updates; a capsule turns at about the shear rate, so they move by about 0.01 rad
+/// (a node near the tip of an elongated capsule a few times that). Updating every step cost up to
+/// a tenth of a 3D capsule's step (32768 triangles scanned twice per step: the equivalent
+/// ellipsoid and the middle section); the values at the steps that read them are the same
+/// (diagnostics::AngleUnwrapper depends on the angle alone, not on the samples between). Not the
+/// same only for a shape that becomes round (Taylor parameter below round_capsule_taylor) for
+/// less than this interval, whose axis then keeps its branch instead of starting afresh.
+inline constexpr double capsule_track_interval = 0.01;
+
 /// Below this Taylor parameter an initially round capsule has no axis worth following.
 inline constexpr double round_capsule_taylor = 1e-4;
 
@@ -60,7 +71,8 @@ inline double follow_axis(diagnostics::AngleUnwrapper& unwrap, double taylor, do
 }
 
 /// The inclination and the tracked node's phase, kept continuous in time; their history is the
-/// only state of a track that a restart must restore (the shape is recomputed every step).
+/// only state of a track that a restart must restore (the shape is recomputed by the next update,
+/// before anything reads it).
 struct TrackAngles {
   diagnostics::AngleUnwrapper inclination{std::numbers::pi}, phase{2 * std::numbers::pi};
   template <class Archive>
@@ -121,7 +133,7 @@ class CapsuleTrack<2> {
   /// Enclosed area over its initial value, minus 1 (the 2D volume, for the guards).
   double volume_change() const { return shape_.area / area0_ - 1.0; }
 
-  /// The unwrapping history (io/checkpoint.hpp archive); the shape is recomputed every step.
+  /// The unwrapping history (io/checkpoint.hpp archive); the shape is recomputed by the next update.
   template <class Archive>
   void checkpoint(Archive& ar, const std::string& prefix) { angles_.checkpoint(ar, prefix); }
 

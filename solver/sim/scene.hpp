@@ -128,6 +128,7 @@ class Scene {
     const long total = units_.coarse_steps;
     const long sample_every = series_sample_every(spec_, units_);
     const long guard_every = spec_.numerics.guards.every;
+    const long track_every = std::max(1L, static_cast<long>(capsule_track_interval / dt));
     std::vector<long> snapshot_steps;
     for (double ts : spec_.outputs.snapshots.times) snapshot_steps.push_back(std::lround(std::ceil(ts / dt - 1e-9)));
 
@@ -163,7 +164,6 @@ class Scene {
         step_ = step;
         core::timed(seconds_fluid_, [&] { fluid_.step(hook, swept); });
         const double t = step * dt;
-        if (!capsules_.empty()) core::timed(seconds_diagnostics_, [&] { track_capsules(); });
         if (step == policy.sigterm_at_step) std::raise(SIGTERM);
         // A stop request (core/interrupt.hpp) ends the run after this step and its checkpoint.
         const bool stop = step < total && core::stop_signal() != 0;
@@ -171,9 +171,14 @@ class Scene {
             step < total && (stop || (every_steps > 0 && step % every_steps == 0) ||
                              (policy.wall_seconds > 0 && seconds_since(last_checkpoint) >= policy.wall_seconds));
         // A checkpoint is always a state that passed the guards (the last good state).
-        if (step % guard_every == 0 || step == total || checkpoint_due)
-          core::timed(seconds_diagnostics_, [&] { check_guards(step); });
-        if (step % sample_every == 0 || step == total) {
+        const bool guard_due = step % guard_every == 0 || step == total || checkpoint_due;
+        const bool sample_due = step % sample_every == 0 || step == total;
+        // The capsules' shapes at every step that reads them, and often enough in between to
+        // keep their angles continuous (track_every).
+        if (!capsules_.empty() && (step % track_every == 0 || guard_due || sample_due))
+          core::timed(seconds_diagnostics_, [&] { track_capsules(); });
+        if (guard_due) core::timed(seconds_diagnostics_, [&] { check_guards(step); });
+        if (sample_due) {
           core::timed(seconds_diagnostics_, [&] { sample(t, row); });
           core::timed(seconds_output_, [&] { series.append(row); });
           series_rows_.insert(series_rows_.end(), row.begin(), row.end());
@@ -455,7 +460,8 @@ class Scene {
     }
   }
 
-  /// Shape of each capsule after a coarse step (capsule_track.hpp). A surface the shape
+  /// Shape of each capsule after a coarse step (capsule_track.hpp), at the steps that read it
+  /// and at least every capsule_track_interval of time (Scene::run). A surface the shape
   /// diagnostics reject (it encloses no volume, a non-finite node) is a membrane that has
   /// diverged: exit 3, like the guards, not a failure of the program.
   void track_capsules() {

@@ -50,6 +50,19 @@ TEST(AngleUnwrapper, FollowsAnAxisThroughManyTurns) {
   EXPECT_DOUBLE_EQ(unwrap(0.3), 0.3);
 }
 
+// The capsule tracks update their shape only every so often (sim/capsule_track.hpp,
+// capsule_track_interval): the unwrapped value must not depend on the samples in between.
+TEST(AngleUnwrapper, ValueDoesNotDependOnTheSamplesBetween) {
+  AngleUnwrapper every(pi), sparse(pi);
+  for (int i = 0; i <= 2000; ++i) {
+    const double truth = -0.037 * i + 0.2 * std::sin(0.01 * i);    // about 74 rad clockwise, swinging
+    const double axis = truth - pi * std::floor(truth / pi + 0.5);  // folded into [-pi/2, pi/2)
+    const double dense = every(axis);
+    if (i % 7 != 0) continue;
+    ASSERT_EQ(sparse(axis), dense) << "sample " << i;  // the same double, not just close
+  }
+}
+
 TEST(CapsuleMotion, SteadyTankTreading) {
   const auto s = sample(10, 0.01, [](double t) { return pi / 4 - 0.2 * (1 - std::exp(-t)); });
   const auto m = classify_capsule_motion(s.t, s.theta, 6);
