@@ -817,32 +817,54 @@ class Scene {
   /// fine block are caught by the IB stage itself (guarded()).
   void check_guards(long step) const {
     const auto& g = spec_.numerics.guards;
+    // What is wrong with a node's moments, or nothing.
+    auto problem_of = [&](const auto& m) -> std::string {
+      double u2 = 0;
+      for (int a = 0; a < D; ++a) u2 += m.u[a] * m.u[a];
+      if (!std::isfinite(m.rho) || !std::isfinite(u2)) return "non-finite density or velocity";
+      if (std::sqrt(3.0 * u2) > g.max_mach)
+        return fmt::format("local Mach number {:.3f} above numerics.guards.max_mach = {}", std::sqrt(3.0 * u2),
+                           g.max_mach);
+      if (std::abs(m.rho - 1.0) > g.max_density_deviation)
+        return fmt::format("density {:.4f} deviates from 1 by more than numerics.guards.max_density_deviation = {}",
+                           m.rho, g.max_density_deviation);
+      return {};
+    };
     for (std::size_t b = 0; b < fluid_.block_count(); ++b) {
       const auto& blk = fluid_.block(b);
       const auto& grid = blk.pop.grid();
-      std::string problem;
-      Index<D> where{};
-      field::for_each_interior<D>(grid, [&](const Index<D>& ijk) {
-        // Coarse nodes under the fine block are restricted from it (outermost layer) or evolve
-        // unread (deeper): the fine node is checked.
-        if (!problem.empty() || (b == 0 && fluid_.two_level() && fluid_.coupling().covered(ijk))) return;
-        const auto m = collision::node_moments<L, T>(blk.pop, grid.index(ijk));
-        double u2 = 0;
-        for (int a = 0; a < D; ++a) u2 += m.u[a] * m.u[a];
-        if (!std::isfinite(m.rho) || !std::isfinite(u2))
-          problem = "non-finite density or velocity";
-        else if (std::sqrt(3.0 * u2) > g.max_mach)
-          problem = fmt::format("local Mach number {:.3f} above numerics.guards.max_mach = {}", std::sqrt(3.0 * u2),
-                                g.max_mach);
-        else if (std::abs(m.rho - 1.0) > g.max_density_deviation)
-          problem = fmt::format("density {:.4f} deviates from 1 by more than numerics.guards.max_density_deviation = {}",
-                                m.rho, g.max_density_deviation);
-        if (!problem.empty()) where = ijk;
-      });
-      if (!problem.empty())
-        throw core::NumericalError(
-            step, fmt::format("{} block, node at ({}) L", units_.blocks[b].name, position_text(grid.position(where))),
-            problem, flow_divergence_cause(units_.blocks[b].tau));
+      const Index<D> n = grid.n();
+      // The first offending node in memory order (the same whatever the thread count), planes
+      // (the last axis) in parallel; its message is written afterwards.
+      const int planes = n[D - 1];
+      const std::ptrdiff_t per_plane = grid.interior_size() / planes;
+      std::ptrdiff_t first = grid.interior_size();
+#pragma omp parallel for schedule(static) reduction(min : first)
+      for (int p = 0; p < planes; ++p) {
+        for (std::ptrdiff_t k = 0; k < per_plane && k + p * per_plane < first; ++k) {
+          Index<D> ijk;
+          ijk[0] = static_cast<int>(k % n[0]);
+          if constexpr (D == 3) ijk[1] = static_cast<int>(k / n[0]);
+          ijk[D - 1] = p;
+          // Coarse nodes under the fine block are restricted from it (outermost layer) or evolve
+          // unread (deeper): the fine node is checked.
+          if (b == 0 && fluid_.two_level() && fluid_.coupling().covered(ijk)) continue;
+          if (!problem_of(collision::node_moments<L, T>(blk.pop, grid.index(ijk))).empty()) {
+            first = std::min(first, k + p * per_plane);
+            break;
+          }
+        }
+      }
+      if (first == grid.interior_size()) continue;
+      Index<D> where;
+      for (int a = 0; a < D; ++a) {
+        where[a] = static_cast<int>(first % n[a]);
+        first /= n[a];
+      }
+      throw core::NumericalError(
+          step, fmt::format("{} block, node at ({}) L", units_.blocks[b].name, position_text(grid.position(where))),
+          problem_of(collision::node_moments<L, T>(blk.pop, grid.index(where))),
+          flow_divergence_cause(units_.blocks[b].tau));
     }
     for (std::size_t c = 0; c < capsules_.size(); ++c) {
       const auto& cap = capsules_[c];
