@@ -884,10 +884,7 @@ class Scene {
         throw core::NumericalError(
             step, fmt::format("capsule '{}', membrane {} {} at ({}) L", cap.name(), element, h.folded,
                               position_text(h.folded_at)),
-            fmt::format("the {} is folded over its neighbours (inverted)", element),
-            "either the explicit coupling is too stiff for the time step (a small capillary number G: lower "
-            "numerics.lattice_velocity), or the membrane buckles or wrinkles below what its mesh "
-            "resolves (the thesis reports wrinkles in long runs: a finer membrane or bending stiffness)");
+            fmt::format("the {} is folded over its neighbours (inverted)", element), folded_cause(cap));
       if (!(h.min_ratio >= g.min_area_ratio))
         throw core::NumericalError(
             step, fmt::format("capsule '{}', membrane {} {} at ({}) L", cap.name(), element, h.worst,
@@ -898,6 +895,33 @@ class Scene {
             "step (small G: lower numerics.lattice_velocity), or the deformation is larger than the mesh resolves "
             "(large G: a finer membrane; for Skalak a larger area_dilation C)");
     }
+  }
+
+  /// The likely cause of a folded membrane element: the explicit coupling too stiff for the time
+  /// step, or, when the membrane's lattice modulus is far below the coupling's limit (what
+  /// `caplab check` prints), the membrane buckling under compression below its mesh's scale.
+  std::string folded_cause(const Capsule<D>& cap) const {
+    const auto& bodies = spec_.physics.bodies;
+    const auto body = std::find_if(bodies.begin(), bodies.end(), [&](const auto& b) { return b.name == cap.name(); });
+    const double E_lu = membrane_lattice_modulus(units_, *body);
+    const double limit = membrane_stiffness_limit(D);
+    const std::string modulus = fmt::format("the membrane's lattice modulus E_lu = {:.3g} against the explicit "
+                                            "coupling's limit of about {:g} (`caplab check`)",
+                                            E_lu, limit);
+    // A factor 10 below the limit: the stress maps (make stress) found the blow-up near it, not there.
+    if (E_lu < 0.1 * limit) {
+      const double bending = D == 2 ? body->membrane->bending_ratio : 0.0;
+      return fmt::format(
+          "the membrane buckles or wrinkles below what its mesh resolves: compressed somewhere along it with {} "
+          "bending stiffness{}, it folds at the scale of its nodes. Not the time step: {}. More membrane nodes "
+          "(physics.bodies.{}.membrane.{}) resolve the wrinkles, some bending stiffness suppresses them",
+          bending > 0.0 ? "little" : "no", D == 2 ? fmt::format(" (E_b = {:g})", bending) : "", modulus,
+          body - bodies.begin(), D == 2 ? "nodes" : "subdivisions");
+    }
+    return fmt::format("either the explicit coupling is too stiff for the time step ({}; a small capillary number G: "
+                       "lower numerics.lattice_velocity), or the membrane buckles or wrinkles below what its mesh "
+                       "resolves (the thesis reports wrinkles in long runs: a finer membrane or bending stiffness)",
+                       modulus);
   }
 
   void write_snapshot(io::SnapshotWriter<D>& w, double t) const {
