@@ -411,6 +411,36 @@ def test_reproduce_ctrl_c_starts_no_further_case(reproduce_env):
     assert "interrupted" in err
 
 
+def test_reproduce_sigterm_starts_no_further_case_and_records_the_running_one(reproduce_env):
+    """SIGTERM to reproduce alone (`kill PID`): the queued cases do not start, the running one
+    finishes and is recorded, and reproduce exits 143. Before, reproduce died at once and the
+    finished case kept a stamp without an exit code."""
+    r, count, results = reproduce_env["reproduce"], reproduce_env["count"], reproduce_env["results"]
+    proc = r(env_extra={"FAKE_CAPLAB_SLEEP": "2"}, background=True, new_session=True)
+    deadline = time.monotonic() + 60
+    while count() == 0 and time.monotonic() < deadline:
+        time.sleep(0.1)
+    time.sleep(0.5)
+    os.kill(proc.pid, signal.SIGTERM)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 143, out + err
+    assert count() == 1 and "stopped by SIGTERM" in err
+    stamps = [json.loads(p.read_text()) for p in (results / "quick").glob("*.reproduce.json")]
+    assert len(stamps) == 1 and stamps[0]["exit_code"] is not None, stamps
+
+
+def test_reproduce_skips_a_run_finished_after_its_reproduce_stopped(reproduce_env):
+    """A stamp without an exit code (its reproduce was killed while caplab went on) and a manifest
+    that says ok: the run finished; it is not run again."""
+    r, count, results = reproduce_env["reproduce"], reproduce_env["count"], reproduce_env["results"]
+    case_file = str(reproduce_env["catalogue"] / "ch2" / "cylinder_re100.json")
+    assert r(paths=[case_file]).returncode == 0
+    stamp_file = results / "quick" / "ch2__cylinder_re100.reproduce.json"
+    fakes.write_json(stamp_file, dict(json.loads(stamp_file.read_text()), exit_code=None))
+    assert "skipped" in r(paths=[case_file]).stdout
+    assert count("ch2/cylinder_re100") == 1
+
+
 def test_reproduce_parallel_invocations_share_nothing(reproduce_env):
     """Two invocations at once (make -j) on the same case: it runs once, the other skips."""
     r, count = reproduce_env["reproduce"], reproduce_env["count"]
