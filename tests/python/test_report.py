@@ -395,19 +395,25 @@ def test_reproduce_resumes_stopped_run(reproduce_env):
     assert count("ch2/cylinder_re100.resume") == 2 and count("ch2/cylinder_re100.quick") == 4
 
 
+def signal_during_first_case(reproduce_env, send, sleep):
+    """Runs reproduce in a session of its own, calls send(pid) once the first (fake) case runs for
+    `sleep` seconds, and returns (process, stdout, stderr) when it has ended."""
+    proc = reproduce_env["reproduce"](env_extra={"FAKE_CAPLAB_SLEEP": str(sleep)}, background=True, new_session=True)
+    deadline = time.monotonic() + 60
+    while reproduce_env["count"]() == 0 and time.monotonic() < deadline:
+        time.sleep(0.1)
+    time.sleep(0.5)
+    send(proc.pid)
+    out, err = proc.communicate(timeout=120)
+    return proc, out, err
+
+
 def test_reproduce_ctrl_c_starts_no_further_case(reproduce_env):
     """Ctrl-C reaches reproduce and the running caplab (one process group): the running case stops
     (caplab checkpoints it), the queued ones do not start, and reproduce exits 130."""
-    r, count = reproduce_env["reproduce"], reproduce_env["count"]
-    proc = r(env_extra={"FAKE_CAPLAB_SLEEP": "3"}, background=True, new_session=True)
-    deadline = time.monotonic() + 60
-    while count() == 0 and time.monotonic() < deadline:
-        time.sleep(0.1)
-    time.sleep(0.5)
-    os.killpg(proc.pid, signal.SIGINT)
-    out, err = proc.communicate(timeout=120)
+    proc, out, err = signal_during_first_case(reproduce_env, lambda pid: os.killpg(pid, signal.SIGINT), 3)
     assert proc.returncode == 130, out + err
-    assert count() == 1, out + err
+    assert reproduce_env["count"]() == 1, out + err
     assert "interrupted" in err
 
 
@@ -415,14 +421,8 @@ def test_reproduce_sigterm_starts_no_further_case_and_records_the_running_one(re
     """SIGTERM to reproduce alone (`kill PID`): the queued cases do not start, the running one
     finishes and is recorded, and reproduce exits 143. Before, reproduce died at once and the
     finished case kept a stamp without an exit code."""
-    r, count, results = reproduce_env["reproduce"], reproduce_env["count"], reproduce_env["results"]
-    proc = r(env_extra={"FAKE_CAPLAB_SLEEP": "2"}, background=True, new_session=True)
-    deadline = time.monotonic() + 60
-    while count() == 0 and time.monotonic() < deadline:
-        time.sleep(0.1)
-    time.sleep(0.5)
-    os.kill(proc.pid, signal.SIGTERM)
-    out, err = proc.communicate(timeout=120)
+    count, results = reproduce_env["count"], reproduce_env["results"]
+    proc, out, err = signal_during_first_case(reproduce_env, lambda pid: os.kill(pid, signal.SIGTERM), 2)
     assert proc.returncode == 143, out + err
     assert count() == 1 and "stopped by SIGTERM" in err
     stamps = [json.loads(p.read_text()) for p in (results / "quick").glob("*.reproduce.json")]
