@@ -41,8 +41,11 @@
 //            oscillating_tank_treading) accepts either tank-treading mode, any other side
 //            accepts "tumbling";
 //   trend    compare_trend, tolerance 0, in each series of runs that share every parameter
-//            above except "varying" and area_dilation, the fidelity and
-//            numerics.grid.fine_spacing.
+//            above except "varying" and area_dilation, the fidelity,
+//            numerics.grid.fine_spacing and the chapter (the case id's first part): one
+//            chapter's sweep.
+//            A swing amplitude ("inclination_amplitude", "section_inclination_amplitude") is
+//            taken from swinging runs only (a tumbling run has none; its row says so).
 //            "direction": increasing / decreasing (strict; for "metric": "mode", the regimes
 //            ordered steady_tank_treading < oscillating_tank_treading < tumbling, non-strict),
 //            "sequence" (non-decreasing), "approaches" with a numeric "limit" (|v − limit|

@@ -58,7 +58,7 @@ class ScoreClaims : public ::testing::Test {
                   {{"capillary", c.capillary}, {"bending_ratio", c.bending_ratio}, {"reference_curvature", c.curvature}}}};
     body["shape"].update(c.extra_shape);
     body["membrane"].update(c.extra_membrane);
-    const json case_doc = {{"id", "t/" + name},
+    const json case_doc = {{"id", chapter_ + "/" + name},
                            {"physics", {{"reynolds", c.reynolds}, {"bodies", {body}}}},
                            {"numerics", {{"grid", {{"fine_spacing", 0.05}}}}},
                            {"acceptance", acceptance}};
@@ -84,6 +84,7 @@ class ScoreClaims : public ::testing::Test {
   }
 
   fs::path dir_;
+  std::string chapter_ = "t";  // the first part of the case ids run() writes
 };
 
 const json kDvsG = {{"id", "t.D_vs_G"},
@@ -142,6 +143,46 @@ TEST_F(ScoreClaims, TrendSeriesKeepOtherParametersFidelityAndGridApart) {
   EXPECT_EQ(result["claims"][0]["verdict"], "not enough runs");
   EXPECT_EQ(result["claims"][0]["series"].size(), 3u);
   EXPECT_EQ(claims_exit_code(result, true), 0);  // undecided is not a failure
+}
+
+TEST_F(ScoreClaims, TrendSeriesKeepChaptersApart) {
+  // Chapter u's grid-study member matches the capsule of chapter t's sweep but stops early (a
+  // smaller D): it is no point of that sweep.
+  std::vector<fs::path> runs{run("G1", circle_G(0.0125), {{"taylor_deformation_final", 0.1}}),
+                             run("G2", circle_G(0.025), {{"taylor_deformation_final", 0.2}})};
+  chapter_ = "u";
+  runs.push_back(run("G2_short", circle_G(0.025), {{"taylor_deformation_final", 0.05}}));
+  const json c = check(kDvsG, runs);
+  EXPECT_EQ(c["verdict"], "consistent") << c.dump(2);
+  ASSERT_EQ(c["series"].size(), 2u);
+  EXPECT_EQ(c["series"][0]["fixed"]["chapter"], "t");
+  EXPECT_EQ(c["series"][1]["verdict"], "not enough runs");
+}
+
+TEST_F(ScoreClaims, SwingAmplitudeTrendLeavesTumblingRunsOut) {
+  // Thesis 3.2.3: the swing grows with E_b until the capsule tumbles. A tumbling run's half range
+  // grows with its window (4.7 rad here against 2.1 at a larger E_b): no amplitude.
+  const json claim = {{"id", "t.amplitude_vs_Eb"},
+                      {"kind", "trend"},
+                      {"parameters", {{"shape", "circle"}}},
+                      {"metric", "inclination_amplitude"},
+                      {"varying", "bending_ratio"},
+                      {"direction", "increasing"}};
+  auto eb = [](double e) {
+    Capsule c;
+    c.bending_ratio = e;
+    return c;
+  };
+  const std::vector<fs::path> runs{
+      run("Eb0.005", eb(0.005), {{"inclination_amplitude", 0.05}, {"mode", "oscillating_tank_treading"}}),
+      run("Eb0.015", eb(0.015), {{"inclination_amplitude", 0.2}, {"mode", "oscillating_tank_treading"}}),
+      run("Eb0.02", eb(0.02), {{"inclination_amplitude", 4.7}, {"mode", "tumbling"}}),
+      run("Eb0.2", eb(0.2), {{"inclination_amplitude", 2.1}, {"mode", "tumbling"}})};
+  const json c = check(claim, runs);
+  EXPECT_EQ(c["verdict"], "consistent") << c.dump(2);
+  EXPECT_EQ(run_row(c, "Eb0.015")["verdict"], "pass");
+  EXPECT_EQ(run_row(c, "Eb0.2")["note"], "tumbling: no swing amplitude");
+  EXPECT_TRUE(run_row(c, "Eb0.2")["value"].is_null());
 }
 
 TEST_F(ScoreClaims, UnfinishedRunsAreListedNotJudged) {
