@@ -135,9 +135,13 @@ Run load_run(const fs::path& dir) {
   if (run.status == "missing") run.status = "incomplete";  // a directory without manifest: never finished
   for (const json* id : {&member(run.case_doc, "id"), &member(manifest, "case_id")})
     if (run.case_id.empty() && id->is_string()) run.case_id = id->get<std::string>();
-  if (run.case_id.empty()) {
-    run.case_id = dir.filename().string();
-    for (std::size_t at; (at = run.case_id.find("__")) != std::string::npos;) run.case_id.replace(at, 2, "/");
+  if (run.case_id.empty()) {  // results/<fidelity>/<id with "/" as "__"> (scripts/reproduce)
+    const std::string name = dir.filename().string();
+    for (std::size_t i = 0; i < name.size(); ++i)
+      if (name.compare(i, 2, "__") == 0)
+        run.case_id += '/', ++i;
+      else
+        run.case_id += name[i];
   }
   for (const json* f : {&member(manifest, "fidelity"), &member(run.case_doc, "fidelity_applied"),
                         &member(run.summary, "fidelity")})

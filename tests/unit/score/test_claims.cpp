@@ -195,6 +195,14 @@ TEST_F(ScoreClaims, UnfinishedRunsAreListedNotJudged) {
   EXPECT_EQ(run_row(c, "G2")["status"], "incomplete");
   EXPECT_TRUE(run_row(c, "G1")["verdict"].is_null());
   EXPECT_EQ(check(kDvsG, {})["verdict"], "no run");
+  // A run that names no case (no case.json, no case_id): its id from the directory, as
+  // scripts/reproduce names it ("/" as "__").
+  const fs::path bare = run("G3", circle_G(0.05), {{"taylor_deformation_final", 0.1}});
+  const fs::path renamed = bare.parent_path() / "ch2__sub__G3";
+  fs::rename(bare, renamed);
+  fs::remove(renamed / "case.json");
+  const json ids = evaluate_claims(claims({kDvsG}), {renamed});
+  EXPECT_EQ(ids["runs"][0]["run"], "ch2/sub/G3") << ids.dump(2);
 }
 
 TEST_F(ScoreClaims, WhichRunsAClaimIsAbout) {
