@@ -137,11 +137,11 @@ Run load_run(const fs::path& dir) {
     if (run.case_id.empty() && id->is_string()) run.case_id = id->get<std::string>();
   if (run.case_id.empty()) {  // results/<fidelity>/<id with "/" as "__"> (scripts/reproduce)
     const std::string name = dir.filename().string();
-    for (std::size_t i = 0; i < name.size(); ++i)
-      if (name.compare(i, 2, "__") == 0)
-        run.case_id += '/', ++i;
-      else
-        run.case_id += name[i];
+    for (std::size_t i = 0; i < name.size(); ++i) {
+      const bool separator = name.compare(i, 2, "__") == 0;
+      run.case_id += separator ? '/' : name[i];
+      if (separator) ++i;
+    }
   }
   for (const json* f : {&member(manifest, "fidelity"), &member(run.case_doc, "fidelity_applied"),
                         &member(run.summary, "fidelity")})
