@@ -94,6 +94,12 @@ const json kDvsG = {{"id", "t.D_vs_G"},
                     {"varying", "capillary"},
                     {"direction", "increasing"}};
 
+Capsule circle_Eb(double bending_ratio) {
+  Capsule c;
+  c.bending_ratio = bending_ratio;
+  return c;
+}
+
 Capsule circle_G(double g, double re = 0.05) {
   Capsule c;
   c.capillary = g;
@@ -168,16 +174,11 @@ TEST_F(ScoreClaims, SwingAmplitudeTrendLeavesTumblingRunsOut) {
                       {"metric", "inclination_amplitude"},
                       {"varying", "bending_ratio"},
                       {"direction", "increasing"}};
-  auto eb = [](double e) {
-    Capsule c;
-    c.bending_ratio = e;
-    return c;
-  };
   const std::vector<fs::path> runs{
-      run("Eb0.005", eb(0.005), {{"inclination_amplitude", 0.05}, {"mode", "oscillating_tank_treading"}}),
-      run("Eb0.015", eb(0.015), {{"inclination_amplitude", 0.2}, {"mode", "oscillating_tank_treading"}}),
-      run("Eb0.02", eb(0.02), {{"inclination_amplitude", 4.7}, {"mode", "tumbling"}}),
-      run("Eb0.2", eb(0.2), {{"inclination_amplitude", 2.1}, {"mode", "tumbling"}})};
+      run("Eb0.005", circle_Eb(0.005), {{"inclination_amplitude", 0.05}, {"mode", "oscillating_tank_treading"}}),
+      run("Eb0.015", circle_Eb(0.015), {{"inclination_amplitude", 0.2}, {"mode", "oscillating_tank_treading"}}),
+      run("Eb0.02", circle_Eb(0.02), {{"inclination_amplitude", 4.7}, {"mode", "tumbling"}}),
+      run("Eb0.2", circle_Eb(0.2), {{"inclination_amplitude", 2.1}, {"mode", "tumbling"}})};
   const json c = check(claim, runs);
   EXPECT_EQ(c["verdict"], "consistent") << c.dump(2);
   EXPECT_EQ(run_row(c, "Eb0.015")["verdict"], "pass");
@@ -312,17 +313,12 @@ TEST_F(ScoreClaims, RegimeSequenceAndApproachingTrends) {
                  {"metric", "mode"},
                  {"varying", "bending_ratio"},
                  {"direction", "sequence"}};
-  auto eb = [](double v) {
-    Capsule c;
-    c.bending_ratio = v;
-    return c;
-  };
-  const std::vector<fs::path> runs{run("a", eb(0.0), {{"mode", "steady_tank_treading"}}),
-                                   run("b", eb(0.01), {{"mode", "steady_tank_treading"}}),
-                                   run("c", eb(0.02), {{"mode", "oscillating_tank_treading"}}),
-                                   run("d", eb(0.06), {{"mode", "tumbling"}})};
+  const std::vector<fs::path> runs{run("a", circle_Eb(0.0), {{"mode", "steady_tank_treading"}}),
+                                   run("b", circle_Eb(0.01), {{"mode", "steady_tank_treading"}}),
+                                   run("c", circle_Eb(0.02), {{"mode", "oscillating_tank_treading"}}),
+                                   run("d", circle_Eb(0.06), {{"mode", "tumbling"}})};
   EXPECT_EQ(check(stages, runs)["verdict"], "consistent");  // the same regime twice is no reversal
-  const json back = check(stages, {runs[0], runs[3], run("e", eb(0.4), {{"mode", "steady_tank_treading"}})});
+  const json back = check(stages, {runs[0], runs[3], run("e", circle_Eb(0.4), {{"mode", "steady_tank_treading"}})});
   EXPECT_EQ(back["verdict"], "inconsistent");
   EXPECT_NE(back["message"].get<std::string>().find("regime order"), std::string::npos);
 
@@ -332,9 +328,9 @@ TEST_F(ScoreClaims, RegimeSequenceAndApproachingTrends) {
                      {"varying", "bending_ratio"},
                      {"direction", "approaches"},
                      {"limit", 1.0}};
-  const std::vector<fs::path> f{run("f0", eb(0.0), {{"tank_treading_frequency", 0.8}}),
-                                run("f1", eb(0.1), {{"tank_treading_frequency", 1.1}}),
-                                run("f2", eb(0.4), {{"tank_treading_frequency", 0.98}})};
+  const std::vector<fs::path> f{run("f0", circle_Eb(0.0), {{"tank_treading_frequency", 0.8}}),
+                                run("f1", circle_Eb(0.1), {{"tank_treading_frequency", 1.1}}),
+                                run("f2", circle_Eb(0.4), {{"tank_treading_frequency", 0.98}})};
   EXPECT_EQ(check(approaches, f)["verdict"], "consistent");
   approaches["limit"] = 0.0;
   EXPECT_EQ(check(approaches, f)["verdict"], "inconsistent");
