@@ -504,7 +504,8 @@ KindResult check_trend(const json& claim, const std::vector<Chosen>& ok, json& r
     // members of a sweep choose theirs by when they settle.
     fixed["fidelity"] = c.run->fidelity;
     fixed["fine_spacing"] = c.run->fine_spacing;
-    fixed["chapter"] = c.run->case_id.substr(0, c.run->case_id.find('/'));
+    const std::size_t slash = c.run->case_id.rfind('/');  // a user's own case may have no folder
+    fixed["chapter"] = slash == std::string::npos ? std::string() : c.run->case_id.substr(0, slash);
     const auto [it, added] = index.emplace(fixed.dump(), series.size());
     if (added) series.push_back({std::move(fixed), {}, {}, {}});
     Series& s = series[it->second];

@@ -42,8 +42,8 @@
 //            accepts "tumbling";
 //   trend    compare_trend, tolerance 0, in each series of runs that share every parameter
 //            above except "varying" and area_dilation, the fidelity,
-//            numerics.grid.fine_spacing and the chapter (the case id's first part): one
-//            chapter's sweep.
+//            numerics.grid.fine_spacing and the chapter (the case id's folder, "ch3" of
+//            "ch3/circle_G0.04_Eb0"; none for an id without one): one chapter's sweep.
 //            A swing amplitude ("inclination_amplitude", "section_inclination_amplitude") is
 //            taken from swinging runs only (a tumbling run has none; its row says so).
 //            "direction": increasing / decreasing (strict; for "metric": "mode", the regimes

@@ -58,7 +58,7 @@ class ScoreClaims : public ::testing::Test {
                   {{"capillary", c.capillary}, {"bending_ratio", c.bending_ratio}, {"reference_curvature", c.curvature}}}};
     body["shape"].update(c.extra_shape);
     body["membrane"].update(c.extra_membrane);
-    const json case_doc = {{"id", chapter_ + "/" + name},
+    const json case_doc = {{"id", chapter_.empty() ? name : chapter_ + "/" + name},
                            {"physics", {{"reynolds", c.reynolds}, {"bodies", {body}}}},
                            {"numerics", {{"grid", {{"fine_spacing", 0.05}}}}},
                            {"acceptance", acceptance}};
@@ -163,6 +163,11 @@ TEST_F(ScoreClaims, TrendSeriesKeepChaptersApart) {
   ASSERT_EQ(c["series"].size(), 2u);
   EXPECT_EQ(c["series"][0]["fixed"]["chapter"], "t");
   EXPECT_EQ(c["series"][1]["verdict"], "not enough runs");
+  // A user's own cases, ids without a folder, form one sweep.
+  chapter_ = "";
+  const fs::path a = run("mine_G1", circle_G(0.0125), {{"taylor_deformation_final", 0.1}});
+  const fs::path b = run("mine_G2", circle_G(0.025), {{"taylor_deformation_final", 0.2}});
+  EXPECT_EQ(check(kDvsG, {a, b})["verdict"], "consistent");
 }
 
 TEST_F(ScoreClaims, SwingAmplitudeTrendLeavesTumblingRunsOut) {
