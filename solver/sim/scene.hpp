@@ -903,6 +903,7 @@ class Scene {
   std::string folded_cause(const Capsule<D>& cap) const {
     const auto& bodies = spec_.physics.bodies;
     const auto body = std::find_if(bodies.begin(), bodies.end(), [&](const auto& b) { return b.name == cap.name(); });
+    CAPLAB_CHECK(body != bodies.end() && body->membrane, "a capsule is built from a body with a membrane");
     const double E_lu = membrane_lattice_modulus(units_, *body);
     const double limit = membrane_stiffness_limit(D);
     const std::string modulus = fmt::format("the membrane's lattice modulus E_lu = {:.3g} against the explicit "
